@@ -1,0 +1,43 @@
+// Subcommands whose issues have not landed yet: they answer "not implemented yet" with exit 1.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+
+#include "daemon/cli.h"
+
+namespace boxd::cli {
+
+namespace {
+
+void AddStub(CLI::App& app, Runner& run, const char* name, const char* description) {
+    CLI::App* sub = app.add_subcommand(name, description);
+    sub->allow_extras();
+    sub->callback([&run, name] {
+        run = [name] {
+            std::fprintf(stderr, "boxd: %s: not implemented yet\n", name);
+            return kExitInternal;
+        };
+    });
+}
+
+}  // namespace
+
+void AddServe(CLI::App& app, Runner& run) {
+    AddStub(app, run, "serve", "Run the daemon (REST/JSON API)");
+}
+void AddMeasure(CLI::App& app, Runner& run) {
+    AddStub(app, run, "measure", "Measure a recorded session offline");
+}
+void AddCalibrate(CLI::App& app, Runner& run) {
+    AddStub(app, run, "calibrate", "Estimate the station calibration from a reference box");
+}
+void AddRecord(CLI::App& app, Runner& run) {
+    AddStub(app, run, "record", "Drive the station once and write a session");
+}
+void AddSynth(CLI::App& app, Runner& run) {
+    AddStub(app, run, "synth", "Render a synthetic session");
+}
+void AddSimTurntable(CLI::App& app, Runner& run) {
+    AddStub(app, run, "sim-turntable", "Run a simulated Modbus turntable");
+}
+
+}  // namespace boxd::cli

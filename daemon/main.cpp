@@ -1,0 +1,34 @@
+// boxd: parcel dimensioner. Parses the command line and runs one subcommand.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+#include <spdlog/spdlog.h>
+
+#include "daemon/cli.h"
+
+int main(int argc, char** argv) {
+    using namespace boxd::cli;
+    SetupLogging();
+    CLI::App app{"boxd: measures parcels on a turntable with a depth camera"};
+    app.name("boxd");
+    app.require_subcommand(1, 1);
+    Runner run;
+    AddServe(app, run);
+    AddMeasure(app, run);
+    AddCalibrate(app, run);
+    AddRecord(app, run);
+    AddSynth(app, run);
+    AddSimTurntable(app, run);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        if (e.get_exit_code() == 0) return app.exit(e);  // --help
+        return FailBadInput(std::string(e.what()) + " (see boxd --help)");
+    }
+    try {
+        return run ? run() : kExitBadInput;
+    } catch (const std::exception& e) {
+        spdlog::critical("internal failure: {}", e.what());
+        return kExitInternal;
+    }
+}

@@ -1,0 +1,89 @@
+#include "pipeline/measurement.h"
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <nlohmann/json.hpp>
+
+namespace boxd {
+
+using nlohmann::json;
+
+namespace {
+
+// Rounds to 0.1 mm / 0.1 ms-class precision so the JSON stays readable and stable.
+double Round(double v, double step) { return std::round(v / step) * step; }
+
+json Array3(const std::array<double, 3>& a, double step) {
+    return json::array({Round(a[0], step), Round(a[1], step), Round(a[2], step)});
+}
+
+}  // namespace
+
+const char* StatusName(MeasurementStatus s) {
+    switch (s) {
+        case MeasurementStatus::kOk:
+            return "ok";
+        case MeasurementStatus::kNoDim:
+            return "no_dim";
+        case MeasurementStatus::kFailed:
+            return "failed";
+    }
+    return "failed";
+}
+
+json ToJson(const MeasurementResult& m) {
+    json j;
+    j["id"] = m.id;
+    j["started_at"] = m.started_at;
+    j["finished_at"] = m.finished_at;
+    j["status"] = StatusName(m.status);
+    j["reason"] = m.reason ? json{{"code", m.reason->code}, {"message", m.reason->message}}
+                           : json(nullptr);
+    if (m.dimensions) {
+        const auto& d = *m.dimensions;
+        j["dimensions"] = {{"length_m", Round(d.length_m, 1e-5)},
+                           {"width_m", Round(d.width_m, 1e-5)},
+                           {"height_m", Round(d.height_m, 1e-5)},
+                           {"volume_m3", Round(d.volume_m3, 1e-7)},
+                           {"method", d.method}};
+    } else {
+        j["dimensions"] = nullptr;
+    }
+    if (m.obb) {
+        const auto& b = *m.obb;
+        j["obb"] = {{"method", b.method},
+                    {"extent_m", Array3(b.extent_m, 1e-5)},
+                    {"volume_m3", Round(b.volume_m3, 1e-7)},
+                    {"center_m", Array3(b.center_m, 1e-5)},
+                    {"axes", {Array3(b.axes[0], 1e-6), Array3(b.axes[1], 1e-6),
+                              Array3(b.axes[2], 1e-6)}},
+                    {"frame", b.frame}};
+    } else {
+        j["obb"] = nullptr;
+    }
+    j["quality"] = {{"poses", m.quality.poses},
+                    {"points", m.quality.points},
+                    {"registration_rmse_m", Round(m.quality.registration_rmse_m, 1e-6)},
+                    {"confidence", Round(m.quality.confidence, 1e-3)}};
+    json timing = json::object();
+    for (const auto& [stage, ms] : m.timing_ms) timing[stage] = Round(ms, 0.1);
+    j["timing_ms"] = timing;
+    return j;
+}
+
+std::string UtcTimestampNow() {
+    using namespace std::chrono;
+    const auto now = system_clock::now();
+    const auto ms = duration_cast<milliseconds>(now.time_since_epoch()).count() % 1000;
+    const std::time_t t = system_clock::to_time_t(now);
+    std::tm tm{};
+    gmtime_r(&t, &tm);
+    char buf[32];
+    std::strftime(buf, sizeof(buf), "%Y-%m-%dT%H:%M:%S", &tm);
+    char out[40];
+    std::snprintf(out, sizeof(out), "%s.%03dZ", buf, static_cast<int>(ms));
+    return out;
+}
+
+}  // namespace boxd

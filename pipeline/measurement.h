@@ -1,0 +1,76 @@
+#pragma once
+// The measurement result of SPEC section 5, and its JSON form.
+
+#include <array>
+#include <map>
+#include <nlohmann/json_fwd.hpp>
+#include <optional>
+#include <string>
+
+namespace boxd {
+
+enum class MeasurementStatus { kOk, kNoDim, kFailed };
+
+// The spec's no-dimension reason codes.
+namespace reason {
+inline constexpr const char* kNoObject = "NO_OBJECT";
+inline constexpr const char* kObjectTooSmall = "OBJECT_TOO_SMALL";
+inline constexpr const char* kObjectTooLarge = "OBJECT_TOO_LARGE";
+inline constexpr const char* kRegistrationFailed = "REGISTRATION_FAILED";
+inline constexpr const char* kObjectMoved = "OBJECT_MOVED";
+inline constexpr const char* kInsufficientData = "INSUFFICIENT_DATA";
+inline constexpr const char* kCameraError = "CAMERA_ERROR";
+inline constexpr const char* kTurntableError = "TURNTABLE_ERROR";
+inline constexpr const char* kNotCalibrated = "NOT_CALIBRATED";
+}  // namespace reason
+
+struct MeasurementReason {
+    std::string code;
+    std::string message;
+};
+
+struct MeasuredDimensions {
+    double length_m = 0.0;
+    double width_m = 0.0;
+    double height_m = 0.0;
+    double volume_m3 = 0.0;
+    std::string method = "footprint";  // footprint | pca
+};
+
+struct OrientedBox {
+    std::string method = "pca";
+    std::array<double, 3> extent_m{};
+    double volume_m3 = 0.0;
+    std::array<double, 3> center_m{};
+    std::array<std::array<double, 3>, 3> axes{};  // rows are the box axes
+    std::string frame = "table";
+};
+
+struct MeasurementQuality {
+    int poses = 0;
+    long points = 0;
+    double registration_rmse_m = 0.0;
+    double confidence = 0.0;
+};
+
+struct MeasurementResult {
+    std::string id;
+    std::string started_at;   // ISO-8601 UTC, millisecond precision
+    std::string finished_at;  // ISO-8601 UTC, millisecond precision
+    MeasurementStatus status = MeasurementStatus::kFailed;
+    std::optional<MeasurementReason> reason;
+    std::optional<MeasuredDimensions> dimensions;
+    std::optional<OrientedBox> obb;
+    MeasurementQuality quality;
+    std::map<std::string, double> timing_ms;  // stage name -> milliseconds
+};
+
+const char* StatusName(MeasurementStatus s);
+
+// Returns the SPEC section 5 JSON object of `m`.
+nlohmann::json ToJson(const MeasurementResult& m);
+
+// Returns the current UTC time as "2026-11-21T10:00:00.000Z".
+std::string UtcTimestampNow();
+
+}  // namespace boxd

@@ -1,0 +1,19 @@
+#include "pipeline/session.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace boxd {
+
+double Session::PoseAngleRad(std::size_t i) const {
+    const double rad = poses.at(i).angle_deg * M_PI / 180.0;
+    return direction == TurntableDirection::kCcw ? rad : -rad;
+}
+
+std::string SessionFramePath(std::size_t pose, std::size_t frame) {
+    char buf[64];
+    std::snprintf(buf, sizeof(buf), "pose_%03zu/frame_%02zu.png", pose, frame);
+    return buf;
+}
+
+}  // namespace boxd

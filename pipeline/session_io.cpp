@@ -1,0 +1,369 @@
+#include "pipeline/session_io.h"
+
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <optional>
+#include <thread>
+
+namespace boxd {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+Error SessionError(const fs::path& file, const std::string& field, const std::string& why) {
+    std::string msg = file.string() + ": ";
+    if (!field.empty()) msg += field + ": ";
+    return Error{"INVALID_SESSION", msg + why};
+}
+
+// Reads fields of session.json, remembering the file for error messages.
+class JsonReader {
+public:
+    explicit JsonReader(fs::path file) : file_(std::move(file)) {}
+
+    Result<const json*> Member(const json& obj, const std::string& parent, const std::string& key,
+                               bool required = true) const {
+        const std::string field = parent.empty() ? key : parent + "." + key;
+        if (!obj.is_object()) return SessionError(file_, parent, "must be an object");
+        auto it = obj.find(key);
+        if (it == obj.end()) {
+            if (required) return SessionError(file_, field, "missing required key");
+            return static_cast<const json*>(nullptr);
+        }
+        return &*it;
+    }
+
+    Result<double> Number(const json& obj, const std::string& parent, const std::string& key) const {
+        auto m = Member(obj, parent, key);
+        if (!m) return m.error();
+        const std::string field = parent + "." + key;
+        if (!(*m)->is_number()) return SessionError(file_, field, "must be a number");
+        const double v = (*m)->get<double>();
+        if (!std::isfinite(v)) return SessionError(file_, field, "must be finite");
+        return v;
+    }
+
+    Result<Eigen::Vector3d> Vector3(const json& obj, const std::string& parent,
+                                    const std::string& key) const {
+        auto m = Member(obj, parent, key);
+        if (!m) return m.error();
+        const std::string field = parent + "." + key;
+        const json& a = **m;
+        if (!a.is_array() || a.size() != 3) {
+            return SessionError(file_, field, "must be an array of 3 numbers");
+        }
+        Eigen::Vector3d v;
+        for (int i = 0; i < 3; ++i) {
+            if (!a[i].is_number()) return SessionError(file_, field, "must hold numbers");
+            v[i] = a[i].get<double>();
+        }
+        return v;
+    }
+
+    const fs::path& file() const { return file_; }
+
+private:
+    fs::path file_;
+};
+
+// A frame path must stay inside the session folder.
+bool IsContainedRelativePath(const std::string& p) {
+    if (p.empty()) return false;
+    const fs::path path(p);
+    if (path.is_absolute() || path.has_root_name() || path.has_root_directory()) return false;
+    for (const auto& part : path) {
+        if (part == "..") return false;
+    }
+    return true;
+}
+
+Result<CameraIntrinsics> ParseCamera(const JsonReader& r, const json& root) {
+    auto cam = r.Member(root, "", "camera");
+    if (!cam) return cam.error();
+    CameraIntrinsics c;
+    const json& j = **cam;
+    for (const char* key : {"width", "height"}) {
+        auto m = r.Member(j, "camera", key);
+        if (!m) return m.error();
+        if (!(*m)->is_number_integer()) {
+            return SessionError(r.file(), std::string("camera.") + key, "must be an integer");
+        }
+    }
+    c.width = j["width"].get<int>();
+    c.height = j["height"].get<int>();
+    struct Field {
+        const char* key;
+        double* dst;
+    };
+    for (Field f : {Field{"fx", &c.fx}, Field{"fy", &c.fy}, Field{"cx", &c.cx},
+                    Field{"cy", &c.cy}, Field{"depth_unit_m", &c.depth_unit_m}}) {
+        auto v = r.Number(j, "camera", f.key);
+        if (!v) return v.error();
+        *f.dst = *v;
+    }
+    if (auto s = c.Validate("camera"); !s) return SessionError(r.file(), "", s.error().message);
+    return c;
+}
+
+Result<StationCalibration> ParseCalibration(const JsonReader& r, const json& root) {
+    auto cal = r.Member(root, "", "calibration");
+    if (!cal) return cal.error();
+    const json& j = **cal;
+    StationCalibration c;
+    auto center = r.Vector3(j, "calibration", "table_center_m");
+    if (!center) return center.error();
+    auto axis = r.Vector3(j, "calibration", "table_axis");
+    if (!axis) return axis.error();
+    auto offset = r.Number(j, "calibration", "depth_offset_m");
+    if (!offset) return offset.error();
+    c.table_center_m = *center;
+    c.table_axis = *axis;
+    c.depth_offset_m = *offset;
+    auto scale_member = r.Member(j, "calibration", "depth_scale", /*required=*/false);
+    if (!scale_member) return scale_member.error();
+    if (*scale_member != nullptr) {
+        auto scale = r.Number(j, "calibration", "depth_scale");
+        if (!scale) return scale.error();
+        c.depth_scale = *scale;
+    }
+    if (auto s = c.Validate("calibration"); !s) {
+        return SessionError(r.file(), "", s.error().message);
+    }
+    return c;
+}
+
+Result<DepthImage> ReadFrame(const fs::path& file, const std::string& field,
+                             const CameraIntrinsics& camera) {
+    std::error_code ec;
+    if (!fs::is_regular_file(file, ec)) return SessionError(file, field, "file not found");
+    const cv::Mat img = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
+    if (img.empty()) return SessionError(file, field, "not a readable image");
+    if (img.depth() != CV_16U || img.channels() != 1) {
+        return SessionError(file, field, "must be a 16-bit unsigned single-channel image");
+    }
+    if (img.cols != camera.width || img.rows != camera.height) {
+        return SessionError(file, field,
+                            "image is " + std::to_string(img.cols) + "x" +
+                                std::to_string(img.rows) + ", camera says " +
+                                std::to_string(camera.width) + "x" +
+                                std::to_string(camera.height));
+    }
+    DepthImage out(img.cols, img.rows);
+    for (int y = 0; y < img.rows; ++y) {
+        const auto* row = img.ptr<std::uint16_t>(y);
+        std::copy(row, row + img.cols, out.pixels.begin() + static_cast<std::ptrdiff_t>(y) * img.cols);
+    }
+    return out;
+}
+
+Result<std::vector<SessionPose>> ParsePoses(const JsonReader& r, const json& root) {
+    auto poses = r.Member(root, "", "poses");
+    if (!poses) return poses.error();
+    const json& arr = **poses;
+    if (!arr.is_array()) return SessionError(r.file(), "poses", "must be an array");
+    if (arr.empty() || arr.size() > 360) {
+        return SessionError(r.file(), "poses", "must hold 1 to 360 poses, has " +
+                                                   std::to_string(arr.size()));
+    }
+    std::vector<SessionPose> out(arr.size());
+    for (std::size_t i = 0; i < arr.size(); ++i) {
+        const std::string name = "poses[" + std::to_string(i) + "]";
+        auto angle = r.Number(arr[i], name, "angle_deg");
+        if (!angle) return angle.error();
+        out[i].angle_deg = *angle;
+        auto frames = r.Member(arr[i], name, "frames");
+        if (!frames) return frames.error();
+        const json& f = **frames;
+        if (!f.is_array() || f.empty()) {
+            return SessionError(r.file(), name + ".frames", "must be a non-empty array of paths");
+        }
+        for (std::size_t k = 0; k < f.size(); ++k) {
+            const std::string field = name + ".frames[" + std::to_string(k) + "]";
+            if (!f[k].is_string()) return SessionError(r.file(), field, "must be a string");
+            const std::string p = f[k].get<std::string>();
+            if (!IsContainedRelativePath(p)) {
+                return SessionError(r.file(), field,
+                                    "path '" + p + "' must be relative and stay inside the session "
+                                    "folder (no absolute paths, no '..')");
+            }
+            out[i].frame_paths.push_back(p);
+        }
+    }
+    return out;
+}
+
+// Loads every frame of every pose, on two threads (PNG decoding dominates session loading).
+Status LoadFrames(const fs::path& dir, const CameraIntrinsics& camera,
+                  std::vector<SessionPose>& poses) {
+    struct Job {
+        std::size_t pose, frame;
+    };
+    std::vector<Job> jobs;
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+        poses[i].frames.resize(poses[i].frame_paths.size());
+        for (std::size_t k = 0; k < poses[i].frame_paths.size(); ++k) jobs.push_back({i, k});
+    }
+    std::vector<std::optional<Error>> errors(jobs.size());
+    auto work = [&](std::size_t begin, std::size_t step) {
+        for (std::size_t j = begin; j < jobs.size(); j += step) {
+            const auto [i, k] = jobs[j];
+            const std::string field =
+                "poses[" + std::to_string(i) + "].frames[" + std::to_string(k) + "]";
+            auto img = ReadFrame(dir / poses[i].frame_paths[k], field, camera);
+            if (img) {
+                poses[i].frames[k] = std::move(*img);
+            } else {
+                errors[j] = img.error();
+            }
+        }
+    };
+    std::thread helper(work, 1, 2);
+    work(0, 2);
+    helper.join();
+    for (const auto& e : errors) {
+        if (e) return *e;
+    }
+    return OkStatus();
+}
+
+const char* DirectionName(TurntableDirection d) {
+    return d == TurntableDirection::kCcw ? "ccw" : "cw";
+}
+
+}  // namespace
+
+Result<Session> LoadSession(const fs::path& dir) {
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) {
+        return SessionError(dir, "", "session folder not found");
+    }
+    const fs::path file = dir / "session.json";
+    std::ifstream in(file);
+    if (!in) return SessionError(file, "", "cannot open session.json");
+    json root;
+    try {
+        root = json::parse(in);
+    } catch (const json::parse_error& e) {
+        return SessionError(file, "", std::string("not valid JSON: ") + e.what());
+    }
+    JsonReader r(file);
+    if (!root.is_object()) return SessionError(file, "", "must hold a JSON object");
+
+    auto format = r.Member(root, "", "format");
+    if (!format) return format.error();
+    if (!(*format)->is_string() || (*format)->get<std::string>() != kSessionFormat) {
+        return SessionError(file, "format",
+                            std::string("must be \"") + kSessionFormat + "\", got " + (*format)->dump());
+    }
+
+    Session s;
+    if (auto src = r.Member(root, "", "source", false); src && *src && (**src).is_string()) {
+        s.source = (**src).get<std::string>();
+    }
+    auto camera = ParseCamera(r, root);
+    if (!camera) return camera.error();
+    s.camera = *camera;
+    auto calibration = ParseCalibration(r, root);
+    if (!calibration) return calibration.error();
+    s.calibration = *calibration;
+
+    auto turntable = r.Member(root, "", "turntable");
+    if (!turntable) return turntable.error();
+    auto direction = r.Member(**turntable, "turntable", "direction");
+    if (!direction) return direction.error();
+    const std::string dir_name = (*direction)->is_string() ? (*direction)->get<std::string>() : "";
+    if (dir_name == "ccw") {
+        s.direction = TurntableDirection::kCcw;
+    } else if (dir_name == "cw") {
+        s.direction = TurntableDirection::kCw;
+    } else {
+        return SessionError(file, "turntable.direction", "must be \"ccw\" or \"cw\"");
+    }
+
+    auto poses = ParsePoses(r, root);
+    if (!poses) return poses.error();
+    s.poses = std::move(*poses);
+
+    if (auto gt = r.Member(root, "", "ground_truth", false); gt && *gt) {
+        BoxDimensions d;
+        auto l = r.Number(**gt, "ground_truth", "length_m");
+        auto w = r.Number(**gt, "ground_truth", "width_m");
+        auto h = r.Number(**gt, "ground_truth", "height_m");
+        if (!l) return l.error();
+        if (!w) return w.error();
+        if (!h) return h.error();
+        d.length_m = *l;
+        d.width_m = *w;
+        d.height_m = *h;
+        s.ground_truth = d;
+    }
+
+    if (auto st = LoadFrames(dir, s.camera, s.poses); !st) return st.error();
+    return s;
+}
+
+Status WriteSession(const Session& session, const fs::path& dir) {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec) return Error{"IO_ERROR", dir.string() + ": cannot create folder: " + ec.message()};
+
+    json poses = json::array();
+    for (std::size_t i = 0; i < session.poses.size(); ++i) {
+        const SessionPose& p = session.poses[i];
+        json frames = json::array();
+        for (std::size_t k = 0; k < p.frames.size(); ++k) {
+            const std::string rel =
+                k < p.frame_paths.size() ? p.frame_paths[k] : SessionFramePath(i, k);
+            if (!IsContainedRelativePath(rel)) {
+                return Error{"INVALID_INPUT", "frame path '" + rel + "' leaves the session folder"};
+            }
+            const fs::path file = dir / rel;
+            fs::create_directories(file.parent_path(), ec);
+            const DepthImage& img = p.frames[k];
+            const cv::Mat mat(img.height, img.width, CV_16UC1,
+                              const_cast<std::uint16_t*>(img.pixels.data()));
+            if (!cv::imwrite(file.string(), mat, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+                return Error{"IO_ERROR", file.string() + ": cannot write PNG"};
+            }
+            frames.push_back(rel);
+        }
+        poses.push_back({{"angle_deg", p.angle_deg}, {"frames", frames}});
+    }
+    const auto& c = session.camera;
+    const auto& cal = session.calibration;
+    json root = {
+        {"format", kSessionFormat},
+        {"source", session.source},
+        {"camera",
+         {{"width", c.width}, {"height", c.height}, {"fx", c.fx}, {"fy", c.fy}, {"cx", c.cx},
+          {"cy", c.cy}, {"depth_unit_m", c.depth_unit_m}}},
+        {"calibration",
+         {{"table_center_m", {cal.table_center_m.x(), cal.table_center_m.y(), cal.table_center_m.z()}},
+          {"table_axis", {cal.table_axis.x(), cal.table_axis.y(), cal.table_axis.z()}},
+          {"depth_offset_m", cal.depth_offset_m},
+          {"depth_scale", cal.depth_scale}}},
+        {"turntable", {{"direction", DirectionName(session.direction)}}},
+        {"poses", poses},
+    };
+    if (session.ground_truth) {
+        const auto& g = *session.ground_truth;
+        root["ground_truth"] = {
+            {"length_m", g.length_m}, {"width_m", g.width_m}, {"height_m", g.height_m}};
+    }
+    const fs::path file = dir / "session.json";
+    const fs::path tmp = dir / "session.json.tmp";
+    {
+        std::ofstream out(tmp);
+        out << root.dump(2) << "\n";
+        if (!out) return Error{"IO_ERROR", tmp.string() + ": cannot write"};
+    }
+    fs::rename(tmp, file, ec);
+    if (ec) return Error{"IO_ERROR", file.string() + ": cannot write: " + ec.message()};
+    return OkStatus();
+}
+
+}  // namespace boxd

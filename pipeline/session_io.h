@@ -1,0 +1,19 @@
+#pragma once
+// Reading and writing sessions in the boxd.session/1 folder format (SPEC section 3).
+
+#include <filesystem>
+
+#include "pipeline/result.h"
+#include "pipeline/session.h"
+
+namespace boxd {
+
+// Returns the session in `dir` with all frames loaded, or an INVALID_SESSION error naming the
+// file and the field that break the format.
+Result<Session> LoadSession(const std::filesystem::path& dir);
+
+// Writes `session` (session.json and every frame as a 16-bit PNG) into `dir`, creating it.
+// Frames are written at their `frame_paths`; a pose without paths gets the standard ones.
+Status WriteSession(const Session& session, const std::filesystem::path& dir);
+
+}  // namespace boxd
