@@ -1,0 +1,176 @@
+// The capture loop.
+#include "drivers/capture_loop.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+namespace boxd {
+
+namespace {
+
+Error ConfigError(const std::string& field, const std::string& what) {
+    return Error{"INVALID_INPUT", "capture." + field + ": " + what};
+}
+
+// Forwards a cancel flag to the turntable while a capture runs: a move in progress is stopped
+// at once rather than at the next pose. RequestStop only sets an atomic flag in the driver, so
+// calling it from this thread is allowed by the Turntable contract.
+class CancelWatcher {
+public:
+    CancelWatcher(const std::atomic<bool>* cancel, Turntable& turntable) {
+        if (!cancel) return;
+        thread_ = std::thread([this, cancel, &turntable] {
+            std::unique_lock lock(mutex_);
+            while (!done_) {
+                if (cancel->load()) {
+                    turntable.RequestStop();
+                    return;
+                }
+                wake_.wait_for(lock, std::chrono::milliseconds(10));
+            }
+        });
+    }
+    ~CancelWatcher() {
+        {
+            std::lock_guard lock(mutex_);
+            done_ = true;
+        }
+        wake_.notify_all();
+        if (thread_.joinable()) thread_.join();
+    }
+
+private:
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    bool done_ = false;
+    std::thread thread_;
+};
+
+bool Cancelled(const CaptureCallbacks& cb) { return cb.cancel && cb.cancel->load(); }
+
+// Sleeps `ms`, waking early when the capture is cancelled; returns false when cancelled.
+bool SleepUnlessCancelled(int ms, const CaptureCallbacks& cb) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
+    while (std::chrono::steady_clock::now() < end) {
+        if (Cancelled(cb)) return false;
+        const auto left = end - std::chrono::steady_clock::now();
+        std::this_thread::sleep_for(
+            std::min<std::chrono::steady_clock::duration>(left, std::chrono::milliseconds(10)));
+    }
+    return !Cancelled(cb);
+}
+
+// Stops the table after an error; a failing stop is logged (the first error is what counts).
+void StopTable(Turntable& turntable) {
+    turntable.ClearStopRequest();
+    if (auto st = turntable.Stop(); !st) {
+        spdlog::error("capture: stopping the turntable failed: {}", st.error().message);
+    }
+}
+
+}  // namespace
+
+Status CaptureConfig::Validate() const {
+    if (angles_deg.empty() && (poses < 1 || poses > 360)) {
+        return ConfigError("poses", "must be 1..360");
+    }
+    if (angles_deg.size() > 360) return ConfigError("angles_deg", "at most 360 angles");
+    for (std::size_t i = 0; i < angles_deg.size(); ++i) {
+        if (!std::isfinite(angles_deg[i]) || std::abs(angles_deg[i]) > 3600.0) {
+            return ConfigError("angles_deg[" + std::to_string(i) + "]",
+                               "must be a finite angle within +-3600 degrees");
+        }
+    }
+    if (frames_per_pose < 1 || frames_per_pose > 100) {
+        return ConfigError("frames_per_pose", "must be 1..100");
+    }
+    if (drop_frames < 0 || drop_frames > 100) return ConfigError("drop_frames", "must be 0..100");
+    if (settle_ms < 0 || settle_ms > 60'000) return ConfigError("settle_ms", "must be 0..60000");
+    if (grab_timeout_ms < 1 || grab_timeout_ms > 60'000) {
+        return ConfigError("grab_timeout_ms", "must be 1..60000");
+    }
+    return OkStatus();
+}
+
+std::vector<double> CaptureConfig::Angles() const {
+    if (!angles_deg.empty()) return angles_deg;
+    std::vector<double> angles;
+    for (int i = 0; i < poses; ++i) angles.push_back(360.0 * i / poses);
+    return angles;
+}
+
+Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
+                               const CaptureConfig& config, const CaptureStation& station,
+                               const CaptureCallbacks& callbacks) {
+    if (auto st = config.Validate(); !st) return st.error();
+    const std::vector<double> angles = config.Angles();
+    const int n = static_cast<int>(angles.size());
+
+    Session session;
+    session.source = camera.SourceName();
+    session.camera = camera.Intrinsics();
+    session.calibration = station.calibration;
+    session.direction = station.direction;
+
+    turntable.ClearStopRequest();
+    CancelWatcher watcher(callbacks.cancel, turntable);
+    const auto timeout = std::chrono::milliseconds(config.grab_timeout_ms);
+    auto cancelled = [&](int pose) -> Error {
+        StopTable(turntable);
+        return Error{kCancelledErrorCode, "capture cancelled at pose " + std::to_string(pose + 1) +
+                                              " of " + std::to_string(n) +
+                                              "; the table was stopped"};
+    };
+
+    for (int k = 0; k < n; ++k) {
+        if (callbacks.on_progress) callbacks.on_progress(k, n);
+        if (Cancelled(callbacks)) return cancelled(k);
+        if (auto st = turntable.MoveTo(angles[k]); !st) {
+            if (Cancelled(callbacks)) return cancelled(k);
+            StopTable(turntable);
+            Error e = st.error();
+            e.message =
+                "pose " + std::to_string(k + 1) + " of " + std::to_string(n) + ": " + e.message;
+            return e;
+        }
+        if (!SleepUnlessCancelled(config.settle_ms, callbacks)) return cancelled(k);
+
+        SessionPose pose;
+        pose.angle_deg = angles[k] - angles[0];
+        for (int f = 0; f < config.drop_frames + config.frames_per_pose; ++f) {
+            if (Cancelled(callbacks)) return cancelled(k);
+            auto frame = camera.Grab(timeout);
+            if (!frame) {
+                StopTable(turntable);
+                return Error{kCameraErrorCode, "pose " + std::to_string(k + 1) + " of " +
+                                                   std::to_string(n) + ": " +
+                                                   frame.error().message};
+            }
+            if (frame->width != session.camera.width || frame->height != session.camera.height) {
+                StopTable(turntable);
+                return CameraError("pose " + std::to_string(k + 1) + ": frame is " +
+                                   std::to_string(frame->width) + "x" +
+                                   std::to_string(frame->height) + ", camera reports " +
+                                   std::to_string(session.camera.width) + "x" +
+                                   std::to_string(session.camera.height));
+            }
+            if (f < config.drop_frames) continue;
+            pose.frame_paths.push_back(
+                SessionFramePath(static_cast<std::size_t>(k), pose.frames.size()));
+            pose.frames.push_back(std::move(frame).value());
+        }
+        spdlog::debug("capture: pose {} of {} at {:.2f} deg: {} frames", k + 1, n, angles[k],
+                      pose.frames.size());
+        session.poses.push_back(std::move(pose));
+        if (callbacks.on_pose) callbacks.on_pose(session.poses.size() - 1, session.poses.back());
+    }
+    if (callbacks.on_progress) callbacks.on_progress(n, n);
+    return session;
+}
+
+}  // namespace boxd

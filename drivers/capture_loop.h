@@ -1,0 +1,63 @@
+#pragma once
+// The capture loop: steps the turntable through the poses and grabs raw depth frames at each.
+// One library function shared by the daemon and `boxd record`.
+
+#include <atomic>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "drivers/depth_camera.h"
+#include "drivers/turntable.h"
+#include "pipeline/result.h"
+#include "pipeline/session.h"
+
+namespace boxd {
+
+inline constexpr const char* kCancelledErrorCode = "CANCELLED";
+
+// The `capture:` section.
+struct CaptureConfig {
+    int poses = 18;                  // evenly spaced over 360° (ignored when angles_deg is set)
+    std::vector<double> angles_deg;  // explicit table angles, relative to the first pose
+    int frames_per_pose = 5;         // raw frames kept per pose
+    int drop_frames = 2;             // frames grabbed and discarded after settling (stale
+                                     // frames exposed while the table still moved)
+    int settle_ms = 200;             // wait after "in position" before grabbing
+    int grab_timeout_ms = 2000;      // per frame
+
+    // Returns an error naming the first invalid field ("capture.<field>: ..."), or Ok.
+    Status Validate() const;
+    // Returns the table angles of the poses in capture order, in degrees.
+    std::vector<double> Angles() const;
+};
+
+// What a capture needs besides the devices: what goes into the session.
+struct CaptureStation {
+    StationCalibration calibration;
+    TurntableDirection direction = TurntableDirection::kCcw;
+};
+
+struct CaptureCallbacks {
+    // Called before pose `pose` (0-based) of `poses` starts moving, and once with
+    // pose == poses when the capture is complete.
+    std::function<void(int pose, int poses)> on_progress;
+    // Called with each pose's raw frames as soon as they are grabbed (while the table has not
+    // yet moved on), so a caller can process pose k while the table moves to k+1. Runs on the
+    // capture thread: hand heavy work to another thread.
+    std::function<void(std::size_t index, const SessionPose& pose)> on_pose;
+    // When it becomes true the table is stopped (also mid-move) and the capture returns a
+    // CANCELLED error.
+    const std::atomic<bool>* cancel = nullptr;
+};
+
+// Captures one session with an open camera: for each pose, moves the table, waits settle_ms,
+// drops drop_frames frames and keeps frames_per_pose raw frames. Returns the session (camera
+// intrinsics, `station` calibration and direction, source = the camera's driver name, commanded
+// angles relative to the first pose), or the first error: TURNTABLE_ERROR, CAMERA_ERROR, or
+// CANCELLED. The table is stopped on every error path.
+Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
+                               const CaptureConfig& config, const CaptureStation& station,
+                               const CaptureCallbacks& callbacks = {});
+
+}  // namespace boxd

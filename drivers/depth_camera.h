@@ -1,0 +1,45 @@
+#pragma once
+// DepthCamera: one small interface over the depth sensors boxd drives (OpenNI2 devices, the
+// simulated station, a recorded session). MakeDepthCamera (driver_registry.h) picks the
+// implementation from the `camera.driver` config string.
+//
+// Errors are boxd::Error{code = "CAMERA_ERROR", message = "<device>: <what happened>"}.
+// Frames are raw 16-bit z-depth in the camera's depth unit (Intrinsics().depth_unit_m), 0 = no
+// reading: never averaged or filtered here (that is the pipeline's job).
+
+#include <chrono>
+#include <string>
+
+#include "pipeline/camera.h"
+#include "pipeline/depth_image.h"
+#include "pipeline/result.h"
+
+namespace boxd {
+
+inline constexpr const char* kCameraErrorCode = "CAMERA_ERROR";
+
+// Returns a CAMERA_ERROR carrying `message`.
+inline Error CameraError(std::string message) {
+    return Error{kCameraErrorCode, std::move(message)};
+}
+
+class DepthCamera {
+public:
+    virtual ~DepthCamera() = default;
+
+    // Connects to the sensor and starts its depth stream; Ok when frames can be grabbed.
+    virtual Status Open() = 0;
+    // Returns the intrinsics of the frames Grab returns (valid after a successful Open).
+    virtual CameraIntrinsics Intrinsics() const = 0;
+    // Returns the next depth frame, or CAMERA_ERROR when none arrives within `timeout` (after
+    // the driver's bounded recovery attempts) or the camera is not open.
+    virtual Result<DepthImage> Grab(std::chrono::milliseconds timeout) = 0;
+    // Stops the stream and releases the sensor; safe to call when not open.
+    virtual void Close() = 0;
+    // Returns the driver name recorded as the session's `source` ("openni2", "simulated", ...).
+    virtual std::string SourceName() const = 0;
+    // Returns a one-line description of the device for logs and status pages.
+    virtual std::string Describe() const = 0;
+};
+
+}  // namespace boxd

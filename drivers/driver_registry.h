@@ -1,0 +1,44 @@
+#pragma once
+// The driver registry: builds the devices a station config names (gpsd style: one small
+// interface per device kind, the implementation picked by a config string).
+//   camera.driver: openni2 | simulated | replay
+//   turntable.driver: modbus-tcp | modbus-rtu | simulated (MakeTurntable); a replay camera
+//   brings its own replay turntable and the turntable section is not used.
+
+#include <memory>
+
+#include "drivers/depth_camera.h"
+#include "drivers/station_config.h"
+#include "drivers/turntable.h"
+
+namespace boxd {
+
+// The devices of one station, ready to capture.
+struct StationDevices {
+    // Declared before the camera: the simulated camera reads this turntable's angle, so the
+    // camera is destroyed first.
+    std::unique_ptr<Turntable> turntable;
+    std::unique_ptr<DepthCamera> camera;
+    // The config's capture settings; for a replay station the session's angles and frame count.
+    CaptureConfig capture;
+    // What goes into captured sessions (config calibration; for replay without one, the
+    // session's).
+    CaptureStation station;
+    bool calibrated = false;  // false when the config carries no calibration
+};
+
+// Returns the camera `config.driver` names (not yet opened). `turntable` is the table whose
+// reported angle the simulated camera renders at (it must outlive the camera); `direction` is
+// the turntable's.
+Result<std::unique_ptr<DepthCamera>> MakeDepthCamera(const CameraConfig& config,
+                                                     Turntable* turntable,
+                                                     TurntableDirection direction);
+
+// Returns the turntable (connected) and the camera (opened) of `config`, or the first
+// TURNTABLE_ERROR / CAMERA_ERROR / INVALID_SESSION error.
+Result<StationDevices> OpenStation(const StationConfig& config);
+
+// Returns the direction a `turntable.direction` string names ("cw" or else ccw).
+TurntableDirection ParseDirection(const std::string& direction);
+
+}  // namespace boxd

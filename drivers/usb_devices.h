@@ -1,0 +1,60 @@
+#pragma once
+// Depth cameras on the USB bus, seen through libusb: listing them (`boxd devices`) and resetting
+// one that stopped delivering frames (the OpenNI2 driver's recovery step).
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pipeline/result.h"
+
+namespace boxd {
+
+// A USB vendor (and optionally product) that boxd knows as an OpenNI2-class depth camera.
+struct KnownDepthCamera {
+    std::uint16_t vendor_id = 0;
+    std::optional<std::uint16_t> product_id;  // empty: every product of the vendor
+    std::string name;
+};
+
+// Returns the table of known depth cameras: PrimeSense (also ASUS Xtion, which ships with the
+// PrimeSense vendor id), Microsoft Kinect v1 camera interfaces, Orbbec.
+const std::vector<KnownDepthCamera>& KnownDepthCameras();
+
+// Returns the name of the known camera with these ids, or nothing when it is not one.
+std::optional<std::string> DepthCameraName(std::uint16_t vendor_id, std::uint16_t product_id);
+
+// One attached USB device.
+struct UsbDeviceInfo {
+    std::uint16_t vendor_id = 0;
+    std::uint16_t product_id = 0;
+    std::string name;       // known camera name, or "" for other devices
+    int bus = 0;            // bus number
+    int address = 0;        // device address on the bus (changes on re-enumeration)
+    std::string port_path;  // "<bus>-<port>.<port>...", stable while the cable stays put
+};
+
+// Returns the attached depth cameras (or every USB device with `all`); an empty list when none
+// are attached; CAMERA_ERROR when libusb cannot be initialised.
+Result<std::vector<UsbDeviceInfo>> ListUsbDevices(bool all = false);
+
+// Bus and address of a USB device.
+struct UsbAddress {
+    int bus = 0;
+    int address = 0;
+};
+
+// Returns the bus/address in an OpenNI2 device URI such as "1d27/0601@1/5", or nothing when the
+// URI does not carry one (files, other drivers).
+std::optional<UsbAddress> UsbAddressFromOpenNiUri(const std::string& uri);
+
+// Resets the USB device at `address` (the device re-enumerates, like unplugging it); resets the
+// first attached known depth camera when `address` is empty. CAMERA_ERROR when there is no such
+// device or the reset fails.
+Status ResetUsbDevice(const std::optional<UsbAddress>& address);
+
+// Returns "045e:02ae" for the ids.
+std::string UsbIdString(std::uint16_t vendor_id, std::uint16_t product_id);
+
+}  // namespace boxd
