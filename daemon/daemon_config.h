@@ -1,0 +1,56 @@
+#pragma once
+// The daemon's own config sections (`server:` and `storage:` in the YAML file), validated at
+// start: a bad value names its key ("server.listen: ...") and stops the start.
+
+#include <cstddef>
+#include <filesystem>
+#include <string>
+
+#include "pipeline/result.h"
+
+namespace YAML {
+class Node;
+}
+
+namespace boxd {
+
+// A TCP listen address, "HOST:PORT" ("[::1]:8080" for IPv6).
+struct ListenAddress {
+    std::string host;
+    int port = 0;  // 0 picks a free port
+};
+
+// Returns the address in `text`, or an error naming `key`.
+Result<ListenAddress> ParseListenAddress(const std::string& text, const std::string& key);
+
+// The `server:` section.
+struct ServerConfig {
+    std::string listen = "127.0.0.1:8080";   // TCP address; "" serves the Unix socket only
+    std::string unix_socket;                 // optional Unix socket path, instead or as well
+    std::string bearer_token;                // when set, POSTs need "Authorization: Bearer <it>"
+    std::size_t max_body_bytes = 64 * 1024;  // larger request bodies get 413
+    int wait_timeout_s = 600;                // longest a POST /v1/measure?wait=1 blocks
+    int threads = 16;                        // HTTP worker threads (a ?wait=1 request holds one)
+
+    // Returns an error naming the first invalid field ("server.<field>: ..."), or Ok.
+    Status Validate() const;
+    bool operator==(const ServerConfig&) const = default;
+};
+
+// The `storage:` section.
+struct StorageConfig {
+    std::string data_dir = "/var/lib/boxd";  // SQLite database, clouds/ and sessions/
+    int retention = 1000;        // finished measurements kept; older rows and files are deleted
+    bool keep_sessions = false;  // also keep each measurement's captured session folder
+
+    // Returns an error naming the first invalid field ("storage.<field>: ..."), or Ok.
+    Status Validate() const;
+};
+
+// Returns the config read from a `server:` YAML node (missing keys keep their defaults;
+// unknown keys, wrong types and invalid values are errors naming the key).
+Result<ServerConfig> ParseServerConfig(const YAML::Node& node);
+// Same for the `storage:` section.
+Result<StorageConfig> ParseStorageConfig(const YAML::Node& node);
+
+}  // namespace boxd

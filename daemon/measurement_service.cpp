@@ -1,0 +1,288 @@
+#include "daemon/measurement_service.h"
+
+#include <spdlog/spdlog.h>
+
+#include <exception>
+
+namespace boxd {
+
+using nlohmann::json;
+
+namespace {
+
+MeasurementResult FailedResult(const Error& error) {
+    MeasurementResult r;
+    r.status = MeasurementStatus::kFailed;
+    r.reason = MeasurementReason{error.code, error.message};
+    return r;
+}
+
+double TimingMs(const MeasurementResult& r, const char* stage) {
+    const auto it = r.timing_ms.find(stage);
+    return it == r.timing_ms.end() ? 0.0 : it->second;
+}
+
+// The one log line per measurement: id, status, dimensions or reason, timing.
+void LogMeasurement(const MeasurementResult& r) {
+    const std::string timing =
+        fmt::format("capture {:.0f} ms, processing {:.0f} ms, total {:.0f} ms",
+                    TimingMs(r, "capture"), TimingMs(r, "processing"), TimingMs(r, "total"));
+    if (r.dimensions) {
+        const auto& d = *r.dimensions;
+        spdlog::info("measurement {} {}: {:.4f} x {:.4f} x {:.4f} m, {:.5f} m3 ({}), {} poses, {}",
+                     r.id, StatusName(r.status), d.length_m, d.width_m, d.height_m, d.volume_m3,
+                     d.method, r.quality.poses, timing);
+    } else {
+        const std::string why = r.reason ? r.reason->code + ": " + r.reason->message : "-";
+        const auto level =
+            r.status == MeasurementStatus::kFailed ? spdlog::level::err : spdlog::level::warn;
+        spdlog::log(level, "measurement {} {}: {}, {} poses, {}", r.id, StatusName(r.status), why,
+                    r.quality.poses, timing);
+    }
+}
+
+}  // namespace
+
+const char* ServiceStateName(ServiceState s) {
+    switch (s) {
+        case ServiceState::kIdle:
+            return "idle";
+        case ServiceState::kMeasuring:
+            return "measuring";
+        case ServiceState::kCalibrating:
+            return "calibrating";
+        case ServiceState::kError:
+            return "error";
+    }
+    return "error";
+}
+
+MeasurementService::MeasurementService(MeasurementStore& store, std::shared_ptr<Station> station,
+                                       bool keep_sessions)
+    : store_(store), station_(std::move(station)), keep_sessions_(keep_sessions) {}
+
+MeasurementService::~MeasurementService() {
+    Abort();
+    Join();
+}
+
+void MeasurementService::set_on_change(std::function<void()> on_change) {
+    std::lock_guard lock(mutex_);
+    on_change_ = std::move(on_change);
+}
+
+void MeasurementService::Notify() {
+    std::function<void()> f;
+    {
+        std::lock_guard lock(mutex_);
+        f = on_change_;
+    }
+    if (f) f();
+}
+
+Status MeasurementService::OpenStation() {
+    std::shared_ptr<Station> station = this->station();
+    Status s = station->Open();
+    {
+        std::lock_guard lock(mutex_);
+        station_ok_ = s.ok();
+        if (!s) {
+            last_error_ = s.error();
+            last_error_at_ = UtcTimestampNow();
+        }
+    }
+    Notify();
+    return s;
+}
+
+std::shared_ptr<Station> MeasurementService::station() const {
+    std::lock_guard lock(mutex_);
+    return station_;
+}
+
+Status MeasurementService::ReplaceStation(std::shared_ptr<Station> station, bool keep_sessions) {
+    {
+        std::lock_guard lock(mutex_);
+        if (running_) return Error{kBusyCode, "a measurement is running"};
+        station_ = std::move(station);
+        keep_sessions_ = keep_sessions;
+        station_ok_ = false;
+    }
+    Notify();
+    return OkStatus();
+}
+
+Result<std::string> MeasurementService::Start() {
+    std::thread previous;
+    {
+        std::lock_guard lock(mutex_);
+        if (shutting_down_) return Error{kShuttingDownCode, "the daemon is stopping"};
+        if (running_) {
+            return Error{kBusyCode, "measurement " + current_id_ + " is running"};
+        }
+        running_ = true;
+        cancel_ = false;
+        current_id_.clear();
+        progress_ = JobProgress{"starting", 0, 0};
+        previous = std::move(worker_);
+    }
+    if (previous.joinable()) previous.join();  // it has finished; only the thread is left
+
+    auto fail = [this](const Error& e) -> Result<std::string> {
+        {
+            std::lock_guard lock(mutex_);
+            running_ = false;
+            last_error_ = e;
+            last_error_at_ = UtcTimestampNow();
+        }
+        finished_cv_.notify_all();
+        Notify();
+        return e;
+    };
+    Result<std::string> id = store_.ReserveId();
+    if (!id) return fail(id.error());
+    Result<std::filesystem::path> scratch = store_.MakeScratchDir(*id);
+    if (!scratch) return fail(scratch.error());
+    {
+        std::lock_guard lock(mutex_);
+        current_id_ = *id;
+        worker_ = std::thread(&MeasurementService::Run, this, *id, *scratch, station_);
+    }
+    spdlog::info("measurement {} started", *id);
+    Notify();
+    return *id;
+}
+
+JobOutput MeasurementService::RunStation(Station& station, const JobContext& ctx) {
+    try {
+        if (!station.IsOpen()) {
+            spdlog::info("opening the station's devices");
+            if (Status s = station.Open(); !s) return JobOutput{FailedResult(s.error()), {}};
+        }
+        return station.Measure(ctx);
+    } catch (const std::exception& e) {
+        // Stations report expected failures as results; anything thrown is a defect, and it
+        // must not take the service loop down with it.
+        spdlog::critical("measurement {}: internal failure: {}", ctx.id, e.what());
+        station.RequestStop();
+        return JobOutput{FailedResult(Error{kInternalErrorCode, e.what()}), {}};
+    }
+}
+
+void MeasurementService::Run(std::string id, std::filesystem::path scratch,
+                             std::shared_ptr<Station> station) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::string started_at = UtcTimestampNow();
+    JobContext ctx;
+    ctx.id = id;
+    ctx.scratch_dir = scratch;
+    ctx.cancel = &cancel_;
+    {
+        std::lock_guard lock(mutex_);
+        ctx.keep_session = keep_sessions_;
+    }
+    ctx.progress = [this](const JobProgress& p) {
+        {
+            std::lock_guard lock(mutex_);
+            progress_ = p;
+        }
+        Notify();
+    };
+
+    JobOutput out = RunStation(*station, ctx);
+    MeasurementResult& r = out.result;
+    r.id = id;
+    r.started_at = started_at;
+    r.finished_at = UtcTimestampNow();
+    r.timing_ms["total"] =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (cancel_ && r.status != MeasurementStatus::kOk) {
+        const std::string why =
+            r.reason ? " (" + r.reason->code + ": " + r.reason->message + ")" : std::string();
+        r.status = MeasurementStatus::kFailed;
+        r.dimensions.reset();
+        r.reason =
+            MeasurementReason{kAbortedCode, "measurement aborted: the daemon is stopping" + why};
+    }
+    const json result = ToJson(r);
+    const Status saved = store_.Save(result, out.files);
+    store_.RemoveScratchDir(id);
+    LogMeasurement(r);
+    if (!saved) spdlog::error("measurement {} not stored: {}", id, saved.error().message);
+    const bool station_ok = station->IsOpen();
+    {
+        std::lock_guard lock(mutex_);
+        running_ = false;
+        current_id_.clear();
+        progress_ = JobProgress{};
+        last_id_ = id;
+        last_result_ = result;
+        ++finished_;
+        station_ok_ = station_ok;
+        if (!saved) {
+            last_error_ = saved.error();
+            last_error_at_ = r.finished_at;
+        } else if (r.status == MeasurementStatus::kFailed && r.reason) {
+            last_error_ = Error{r.reason->code, r.reason->message};
+            last_error_at_ = r.finished_at;
+        }
+    }
+    finished_cv_.notify_all();
+    Notify();
+}
+
+Result<json> MeasurementService::WaitFor(const std::string& id, std::chrono::milliseconds timeout) {
+    {
+        std::unique_lock lock(mutex_);
+        const bool done =
+            finished_cv_.wait_for(lock, timeout, [&] { return !(running_ && current_id_ == id); });
+        if (!done) return Error{kTimeoutCode, "measurement " + id + " is still running"};
+        if (last_id_ == id) return last_result_;
+    }
+    auto stored = store_.Get(id);
+    if (!stored) return stored.error();
+    if (!*stored) return Error{"NOT_FOUND", "no measurement " + id};
+    return std::move(**stored);
+}
+
+void MeasurementService::Abort() {
+    std::shared_ptr<Station> station;
+    {
+        std::lock_guard lock(mutex_);
+        shutting_down_ = true;
+        if (!running_) return;
+        station = station_;
+    }
+    cancel_ = true;
+    station->RequestStop();
+}
+
+void MeasurementService::Join() {
+    std::thread t;
+    {
+        std::lock_guard lock(mutex_);
+        t = std::move(worker_);
+    }
+    if (t.joinable()) t.join();
+}
+
+bool MeasurementService::Busy() const {
+    std::lock_guard lock(mutex_);
+    return running_;
+}
+
+ServiceSnapshot MeasurementService::Snapshot() const {
+    std::lock_guard lock(mutex_);
+    ServiceSnapshot s;
+    s.state = running_ ? ServiceState::kMeasuring
+                       : (station_ok_ ? ServiceState::kIdle : ServiceState::kError);
+    s.measurement_id = current_id_;
+    s.progress = progress_;
+    s.last_error = last_error_;
+    s.last_error_at = last_error_at_;
+    s.last_measurement_id = last_id_;
+    s.finished = finished_;
+    return s;
+}
+
+}  // namespace boxd

@@ -1,0 +1,105 @@
+#pragma once
+// MeasurementService: runs one measurement at a time on its own thread, tracks the state
+// (idle / measuring / calibrating / error) and the progress, stores every finished measurement
+// and lets HTTP handlers wait for one. Thread-safe; HTTP threads and the main loop share it.
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include "daemon/measurement_store.h"
+#include "daemon/station.h"
+#include "pipeline/result.h"
+
+namespace boxd {
+
+enum class ServiceState { kIdle, kMeasuring, kCalibrating, kError };
+
+// Returns "idle" / "measuring" / "calibrating" / "error".
+const char* ServiceStateName(ServiceState s);
+
+// Error codes of the service (besides the station's and the store's).
+inline constexpr const char* kBusyCode = "BUSY";
+inline constexpr const char* kShuttingDownCode = "SHUTTING_DOWN";
+inline constexpr const char* kTimeoutCode = "TIMEOUT";
+inline constexpr const char* kAbortedCode = "ABORTED";
+inline constexpr const char* kInternalErrorCode = "INTERNAL_ERROR";
+
+struct ServiceSnapshot {
+    ServiceState state = ServiceState::kIdle;
+    std::string measurement_id;  // the running one, or empty
+    JobProgress progress;        // of the running one
+    std::optional<Error> last_error;
+    std::string last_error_at;        // UTC timestamp of last_error
+    std::string last_measurement_id;  // the last finished one in this process, or empty
+    int finished = 0;                 // measurements finished since start
+};
+
+class MeasurementService {
+public:
+    MeasurementService(MeasurementStore& store, std::shared_ptr<Station> station,
+                       bool keep_sessions);
+    // Aborts a running measurement and waits for it.
+    ~MeasurementService();
+    MeasurementService(const MeasurementService&) = delete;
+    MeasurementService& operator=(const MeasurementService&) = delete;
+
+    // Brings the station's devices up; on failure the state is `error` with the device error.
+    Status OpenStation();
+
+    // Starts a measurement and returns its id, or BUSY while one runs, SHUTTING_DOWN after
+    // Abort(), STORAGE_ERROR when no id can be reserved.
+    Result<std::string> Start();
+    // Returns the result of measurement `id` once it has finished (it may already have), or
+    // TIMEOUT after `timeout`, SHUTTING_DOWN if the run was abandoned.
+    Result<nlohmann::json> WaitFor(const std::string& id, std::chrono::milliseconds timeout);
+
+    // Stops the running measurement (the table is stopped at once) and refuses new ones.
+    void Abort();
+    // Waits until no measurement runs.
+    void Join();
+
+    bool Busy() const;
+    ServiceSnapshot Snapshot() const;
+    std::shared_ptr<Station> station() const;
+
+    // Puts a new station (and the keep-sessions setting) in force; BUSY while a run uses the
+    // old one. The new station's devices are opened by the caller (OpenStation()).
+    Status ReplaceStation(std::shared_ptr<Station> station, bool keep_sessions);
+
+    // Called (from any thread) whenever the state or the progress changes.
+    void set_on_change(std::function<void()> on_change);
+
+private:
+    void Run(std::string id, std::filesystem::path scratch, std::shared_ptr<Station> station);
+    JobOutput RunStation(Station& station, const JobContext& ctx);
+    void Notify();
+
+    MeasurementStore& store_;
+    mutable std::mutex mutex_;
+    std::condition_variable finished_cv_;
+    std::shared_ptr<Station> station_;
+    bool keep_sessions_ = false;
+    bool station_ok_ = false;
+    bool running_ = false;
+    bool shutting_down_ = false;
+    std::atomic<bool> cancel_{false};
+    std::string current_id_;
+    JobProgress progress_;
+    std::optional<Error> last_error_;
+    std::string last_error_at_;
+    std::string last_id_;
+    nlohmann::json last_result_;  // kept in memory too, in case storing it failed
+    int finished_ = 0;
+    std::thread worker_;
+    std::function<void()> on_change_;
+};
+
+}  // namespace boxd

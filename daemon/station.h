@@ -1,0 +1,65 @@
+#pragma once
+// Station: what the service loop drives — the turntable, the depth camera and the measurement
+// pipeline behind one small interface, so the loop, the API and the store are independent of the
+// drivers (and testable with a station of the test's own).
+
+#include <atomic>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "daemon/measurement_store.h"
+#include "pipeline/measurement.h"
+#include "pipeline/result.h"
+
+namespace boxd {
+
+// Where a running measurement is: pose k of N while capturing, then the processing stage.
+struct JobProgress {
+    std::string stage;  // "capture" | "processing"
+    int pose = 0;       // poses done so far
+    int poses = 0;      // poses in the session
+};
+
+// What one measurement run gets from the service.
+struct JobContext {
+    std::string id;                             // "m-000042"
+    std::filesystem::path scratch_dir;          // empty folder for the run's files
+    bool keep_session = false;                  // also leave the captured session in scratch_dir
+    const std::atomic<bool>* cancel = nullptr;  // set when the run must stop (SIGTERM)
+    std::function<void(const JobProgress&)> progress;  // may be called from the run's thread
+
+    bool cancelled() const { return cancel != nullptr && cancel->load(); }
+};
+
+// What a run hands back: the result (id and timestamps are the service's) and its files.
+struct JobOutput {
+    MeasurementResult result;
+    MeasurementFiles files;  // paths inside the scratch folder, moved into the store
+};
+
+class Station {
+public:
+    virtual ~Station() = default;
+
+    // Brings the devices up (connects, homes); returns the first device error. Called at start
+    // and again before a run when a previous run left the devices in error.
+    virtual Status Open() = 0;
+    // Returns true when Open() succeeded and no device error happened since.
+    virtual bool IsOpen() const = 0;
+    // Captures and measures one parcel. Never throws for expected failures: they come back as a
+    // result with status no_dim/failed and a reason. Returns soon after ctx.cancel is set.
+    virtual JobOutput Measure(const JobContext& ctx) = 0;
+    // Stops the turntable now. Any thread; does not wait for the run to return.
+    virtual void RequestStop() = 0;
+    // Brings the devices to rest before the process exits (table stopped, connections closed).
+    virtual void Shutdown() = 0;
+    // Returns the devices' description and health for GET /v1/status (cached, never blocks on
+    // a device).
+    virtual nlohmann::json Devices() const = 0;
+    // Returns the calibration in force for GET /v1/calibration.
+    virtual nlohmann::json Calibration() const = 0;
+};
+
+}  // namespace boxd
