@@ -33,9 +33,6 @@ void AddCalibrate(CLI::App& app, Runner& run) {
 void AddRecord(CLI::App& app, Runner& run) {
     AddStub(app, run, "record", "Drive the station once and write a session");
 }
-void AddSynth(CLI::App& app, Runner& run) {
-    AddStub(app, run, "synth", "Render a synthetic session");
-}
 void AddSimTurntable(CLI::App& app, Runner& run) {
     AddStub(app, run, "sim-turntable", "Run a simulated Modbus turntable");
 }

@@ -1,0 +1,136 @@
+#include "pipeline/sensor_noise.h"
+
+#include <cmath>
+
+namespace boxd {
+
+namespace {
+
+constexpr double kKinectDisparityScale = -0.0030711016;
+constexpr double kKinectDisparityOffset = 3.3309495161;
+constexpr int kKinectMaxRawDisparity = 2046;  // 2047 marks "no reading" in the 11-bit stream
+
+}  // namespace
+
+const char* NoiseModelName(NoiseModel m) {
+    switch (m) {
+        case NoiseModel::kNone:
+            return "none";
+        case NoiseModel::kKinect:
+            return "kinect";
+        case NoiseModel::kRealSense:
+            return "realsense";
+    }
+    return "none";
+}
+
+Result<NoiseModel> ParseNoiseModel(const std::string& name) {
+    if (name == "none") return NoiseModel::kNone;
+    if (name == "kinect") return NoiseModel::kKinect;
+    if (name == "realsense") return NoiseModel::kRealSense;
+    return Error{"INVALID_INPUT",
+                 "noise: unknown noise model '" + name + "' (expected kinect, realsense or none)"};
+}
+
+Status SensorNoiseParams::Validate(const std::string& where) const {
+    auto bad = [&](const std::string& field, const std::string& why) -> Status {
+        return Error{"INVALID_INPUT", where + "." + field + ": " + why};
+    };
+    auto in = [](double x, double lo, double hi) { return std::isfinite(x) && x >= lo && x <= hi; };
+    if (!in(lateral_sigma_px, 0.0, 10.0)) return bad("lateral_sigma_px", "must be in 0..10");
+    if (!in(stereo_baseline_m, 1e-3, 1.0)) return bad("stereo_baseline_m", "must be in 0.001..1");
+    if (!in(stereo_subpixel, 0.0, 5.0)) return bad("stereo_subpixel", "must be in 0..5");
+    if (!in(flying_pixel_probability, 0.0, 1.0)) {
+        return bad("flying_pixel_probability", "must be in 0..1");
+    }
+    if (!in(flying_pixel_min_jump_m, 0.0, 10.0)) {
+        return bad("flying_pixel_min_jump_m", "must be in 0..10");
+    }
+    if (!in(hole_fraction, 0.0, 1.0)) return bad("hole_fraction", "must be in 0..1");
+    if (!in(dropout_start_deg, 0.0, 90.0)) return bad("dropout_start_deg", "must be in 0..90");
+    if (!in(dropout_full_deg, dropout_start_deg, 90.0)) {
+        return bad("dropout_full_deg", "must be in dropout_start_deg..90");
+    }
+    if (!in(min_range_m, 0.0, 100.0)) return bad("min_range_m", "must be in 0..100");
+    if (std::isnan(max_range_m) || max_range_m <= min_range_m) {
+        return bad("max_range_m", "must be greater than min_range_m");
+    }
+    return OkStatus();
+}
+
+SensorNoiseParams DefaultSensorNoise(NoiseModel model) {
+    SensorNoiseParams p;
+    p.axial = model;
+    switch (model) {
+        case NoiseModel::kNone:
+            break;
+        case NoiseModel::kKinect:
+            // Lateral noise of 0.5-0.8 px (Nguyen et al. 2012); structured light loses the
+            // projected pattern at grazing angles beyond about 75 degrees.
+            p.lateral_sigma_px = 0.65;
+            p.disparity_quantisation = true;
+            p.flying_pixel_probability = 0.35;
+            p.hole_fraction = 0.005;
+            p.dropout_start_deg = 70.0;
+            p.dropout_full_deg = 80.0;
+            p.min_range_m = 0.4;
+            p.max_range_m = 4.5;
+            break;
+        case NoiseModel::kRealSense:
+            // D4xx: sub-pixel stereo matching keeps edges sharper (fewer mixed pixels) and the
+            // lateral error smaller than the Kinect's.
+            p.lateral_sigma_px = 0.3;
+            p.flying_pixel_probability = 0.1;
+            p.hole_fraction = 0.005;
+            p.dropout_start_deg = 72.0;
+            p.dropout_full_deg = 82.0;
+            p.min_range_m = 0.2;
+            p.max_range_m = 6.0;
+            break;
+    }
+    return p;
+}
+
+double KinectAxialSigma(double z_m, double incidence_rad) {
+    const double max_theta = M_PI / 2.0 - 3.0 * M_PI / 180.0;
+    const double theta = std::min(std::abs(incidence_rad), max_theta);
+    const double dz = z_m - 0.4;
+    const double grazing = M_PI / 2.0 - theta;
+    return 0.0012 + 0.0019 * dz * dz +
+           0.0001 / std::sqrt(z_m) * theta * theta / (grazing * grazing);
+}
+
+double StereoAxialSigma(double z_m, double focal_px, double baseline_m, double subpixel) {
+    return z_m * z_m * subpixel / (focal_px * baseline_m);
+}
+
+double AxialSigma(const SensorNoiseParams& params, double z_m, double incidence_rad,
+                  double focal_px) {
+    switch (params.axial) {
+        case NoiseModel::kNone:
+            return 0.0;
+        case NoiseModel::kKinect:
+            return KinectAxialSigma(z_m, incidence_rad);
+        case NoiseModel::kRealSense:
+            return StereoAxialSigma(z_m, focal_px, params.stereo_baseline_m,
+                                    params.stereo_subpixel);
+    }
+    return 0.0;
+}
+
+double KinectRawDisparity(double z_m) {
+    return (1.0 / z_m - kKinectDisparityOffset) / kKinectDisparityScale;
+}
+
+double KinectDepthOfDisparity(int raw) {
+    if (raw < 0 || raw > kKinectMaxRawDisparity) return 0.0;
+    const double inverse = raw * kKinectDisparityScale + kKinectDisparityOffset;
+    return inverse > 0.0 ? 1.0 / inverse : 0.0;
+}
+
+double KinectQuantiseDepth(double z_m) {
+    if (!(z_m > 0.0)) return 0.0;
+    return KinectDepthOfDisparity(static_cast<int>(std::lround(KinectRawDisparity(z_m))));
+}
+
+}  // namespace boxd

@@ -1,0 +1,343 @@
+#include "pipeline/synthetic_station.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "pipeline/synthetic_geometry.h"
+#include "pipeline/synthetic_random.h"
+
+namespace boxd {
+
+namespace {
+
+namespace rnd = synthetic_random;
+
+constexpr double kDegToRad = M_PI / 180.0;
+constexpr int kMaxFramesPerPose = 100;
+constexpr int kRenderThreads = 2;
+
+// Sub-streams of the session seed, one per purpose, so that adding one never shifts another.
+enum Stream : std::uint64_t {
+    kStreamFrames = 1,
+    kStreamAngleError = 2,
+    kStreamCalibration = 3,
+};
+// Sub-streams of a frame seed, one per artefact.
+enum FrameStream : std::uint64_t {
+    kPixel = 1,
+    kDropout = 4,
+    kFlying = 5,
+    kFlyingMix = 6,
+};
+
+Error Bad(const std::string& field, const std::string& why) {
+    return {"INVALID_INPUT", field + ": " + why};
+}
+
+bool Finite(double x) { return std::isfinite(x); }
+
+// Returns how far the box footprint reaches from the axis with its centre at (x, y), turned by
+// yaw_deg (the largest corner radius).
+double FootprintReach(const SyntheticBox& b, double x, double y, double yaw_deg) {
+    const double c = std::cos(yaw_deg * kDegToRad), s = std::sin(yaw_deg * kDegToRad);
+    double reach = 0.0;
+    for (int sx = -1; sx <= 1; sx += 2) {
+        for (int sy = -1; sy <= 1; sy += 2) {
+            const double lx = sx * b.length_m / 2.0, ly = sy * b.width_m / 2.0;
+            reach = std::max(reach, std::hypot(x + c * lx - s * ly, y + s * lx + c * ly));
+        }
+    }
+    return reach;
+}
+
+// Returns a unit vector of uniformly random direction drawn from stream `seed`.
+Eigen::Vector3d RandomUnitVector(std::uint64_t seed, std::uint64_t index) {
+    for (std::uint64_t k = 0;; ++k) {
+        double a = 0, b = 0, c = 0, unused = 0;
+        rnd::Normal2(seed, 2 * (index + k * 1000), a, b);
+        rnd::Normal2(seed, 2 * (index + k * 1000) + 1, c, unused);
+        const Eigen::Vector3d v(a, b, c);
+        if (v.norm() > 1e-6) return v.normalized();
+    }
+}
+
+// Returns the depth of pixel `i` mixed towards its most different neighbour when that neighbour
+// lies across a depth jump: the mixed ("flying") pixels that structured-light and stereo sensors
+// produce at object edges, where the matching window straddles two surfaces.
+float FlyingPixelDepth(const std::vector<float>& z, int w, int h, int x, int y,
+                       const SensorNoiseParams& noise, std::uint64_t seed) {
+    const std::size_t i = static_cast<std::size_t>(y) * w + x;
+    const float zi = z[i];
+    float other = 0.0f;
+    float best_jump = static_cast<float>(noise.flying_pixel_min_jump_m);
+    auto consider = [&](int nx, int ny) {
+        if (nx < 0 || ny < 0 || nx >= w || ny >= h) return;
+        const float zn = z[static_cast<std::size_t>(ny) * w + nx];
+        if (zn <= 0.0f) return;
+        const float jump = std::abs(zn - zi);
+        if (jump >= best_jump) {
+            best_jump = jump;
+            other = zn;
+        }
+    };
+    consider(x - 1, y);
+    consider(x + 1, y);
+    consider(x, y - 1);
+    consider(x, y + 1);
+    if (other <= 0.0f) return zi;
+    if (rnd::Uniform(rnd::Derive(seed, kFlying), i) >= noise.flying_pixel_probability) return zi;
+    const double mix = rnd::Uniform(rnd::Derive(seed, kFlyingMix), i);
+    return static_cast<float>(zi + mix * (other - zi));
+}
+
+}  // namespace
+
+Status SyntheticStationConfig::Validate() const {
+    const SyntheticBox& b = box;
+    for (auto [name, v] : {std::pair{"box.length_m", b.length_m},
+                           {"box.width_m", b.width_m},
+                           {"box.height_m", b.height_m}}) {
+        if (!Finite(v) || v <= 0.0 || v > 5.0) return Bad(name, "must be in (0, 5] metres");
+    }
+    if (!Finite(b.offset_x_m)) return Bad("box.offset_x_m", "must be finite");
+    if (!Finite(b.offset_y_m)) return Bad("box.offset_y_m", "must be finite");
+    if (!Finite(b.yaw_deg)) return Bad("box.yaw_deg", "must be finite");
+    if (auto st = camera.Validate("camera"); !st) return st;
+    if (!Finite(disc_radius_m) || disc_radius_m <= 0.0 || disc_radius_m > 5.0) {
+        return Bad("disc_radius_m", "must be in (0, 5] metres");
+    }
+    if (!Finite(disc_thickness_m) || disc_thickness_m < 0.0 || disc_thickness_m > 1.0) {
+        return Bad("disc_thickness_m", "must be in 0..1 metres");
+    }
+    if (!Finite(floor_drop_m) || floor_drop_m < disc_thickness_m || floor_drop_m > 10.0) {
+        return Bad("floor_drop_m", "must be in disc_thickness_m..10 metres");
+    }
+    const double reach = FootprintReach(b, b.offset_x_m, b.offset_y_m, b.yaw_deg);
+    if (reach > disc_radius_m) {
+        return Bad("box", "the footprint reaches " + std::to_string(reach) +
+                              " m from the axis, beyond the disc radius " +
+                              std::to_string(disc_radius_m) + " m (check dims and offset)");
+    }
+    const SyntheticCameraPose& cp = camera_pose;
+    if (!Finite(cp.distance_m) || cp.distance_m <= 0.0 || cp.distance_m > 20.0) {
+        return Bad("camera_pose.distance_m", "must be in (0, 20] metres");
+    }
+    if (!Finite(cp.elevation_deg) || cp.elevation_deg < 5.0 || cp.elevation_deg > 85.0) {
+        return Bad("camera_pose.elevation_deg", "must be in 5..85 degrees");
+    }
+    if (!Finite(cp.aim_height_m) || cp.aim_height_m < 0.0 || cp.aim_height_m > 5.0) {
+        return Bad("camera_pose.aim_height_m", "must be in 0..5 metres");
+    }
+    {
+        // The camera must look at the scene from outside: not inside the disc's or the box's
+        // reach below the box top.
+        const double el = cp.elevation_deg * kDegToRad;
+        const double horizontal = cp.distance_m * std::cos(el);
+        const double height = cp.aim_height_m + cp.distance_m * std::sin(el);
+        if (horizontal <= std::max(disc_radius_m, reach) && height <= b.height_m) {
+            return Bad("camera_pose.distance_m", "the camera would be inside the scene");
+        }
+    }
+    if (sensor_noise) {
+        if (auto st = sensor_noise->Validate("sensor_noise"); !st) return st;
+    }
+    if (!Finite(angle_error_deg) || angle_error_deg < 0.0 || angle_error_deg > 10.0) {
+        return Bad("angle_error_deg", "must be in 0..10 degrees");
+    }
+    if (!Finite(calib_center_error_m) || calib_center_error_m < 0.0 || calib_center_error_m > 0.1) {
+        return Bad("calib_center_error_m", "must be in 0..0.1 metres");
+    }
+    if (!Finite(calib_axis_error_deg) || calib_axis_error_deg < 0.0 ||
+        calib_axis_error_deg > 10.0) {
+        return Bad("calib_axis_error_deg", "must be in 0..10 degrees");
+    }
+    if (!Finite(true_depth_offset_m) || std::abs(true_depth_offset_m) > 0.5) {
+        return Bad("true_depth_offset_m", "must be within +-0.5 metres");
+    }
+    if (moved_at_pose) {
+        if (*moved_at_pose < 1) return Bad("moved_at_pose", "must be a pose index >= 1");
+        if (!Finite(moved_dx_m)) return Bad("moved_dx_m", "must be finite");
+        if (!Finite(moved_dy_m)) return Bad("moved_dy_m", "must be finite");
+        if (!Finite(moved_dyaw_deg)) return Bad("moved_dyaw_deg", "must be finite");
+        const double moved_reach = FootprintReach(
+            b, b.offset_x_m + moved_dx_m, b.offset_y_m + moved_dy_m, b.yaw_deg + moved_dyaw_deg);
+        if (moved_reach > disc_radius_m) {
+            return Bad("moved_dx_m", "the moved box would reach " + std::to_string(moved_reach) +
+                                         " m from the axis, beyond the disc");
+        }
+    }
+    return OkStatus();
+}
+
+std::uint64_t SyntheticFrameSeed(std::uint64_t seed, int pose, int frame) {
+    const std::uint64_t frames = rnd::Derive(seed, kStreamFrames);
+    return rnd::Derive(rnd::Derive(frames, static_cast<std::uint64_t>(pose)),
+                       static_cast<std::uint64_t>(frame));
+}
+
+double SyntheticTrueAngleDeg(const SyntheticStationConfig& config, int pose, double commanded_deg) {
+    if (pose == 0 || config.angle_error_deg <= 0.0) return commanded_deg;
+    const std::uint64_t s = rnd::Derive(config.seed, kStreamAngleError);
+    return commanded_deg +
+           config.angle_error_deg * rnd::Normal(s, static_cast<std::uint64_t>(pose));
+}
+
+BoxDimensions SyntheticGroundTruth(const SyntheticBox& box) {
+    return {std::max(box.length_m, box.width_m), std::min(box.length_m, box.width_m), box.height_m};
+}
+
+SyntheticScene MakeSyntheticScene(const SyntheticStationConfig& config) {
+    SyntheticScene scene;
+    scene.config = config;
+    scene.noise = config.sensor_noise ? *config.sensor_noise : DefaultSensorNoise(config.noise);
+
+    const SyntheticCameraFrame cam = MakeSyntheticCameraFrame(config.camera_pose);
+    StationCalibration truth;
+    truth.table_center_m = cam.table_to_camera * (-cam.position_m);
+    truth.table_axis = cam.table_to_camera * Eigen::Vector3d::UnitZ();
+    truth.depth_offset_m = config.true_depth_offset_m;
+    truth.depth_scale = 1.0;
+    scene.true_calibration = truth;
+
+    // The recorded calibration: the centre moved by the configured distance in a random
+    // direction, the axis tilted by the configured angle about a random perpendicular.
+    const std::uint64_t s = rnd::Derive(config.seed, kStreamCalibration);
+    StationCalibration recorded = truth;
+    recorded.table_center_m += config.calib_center_error_m * RandomUnitVector(s, 0);
+    Eigen::Vector3d tilt_axis = RandomUnitVector(s, 1);
+    tilt_axis -= tilt_axis.dot(truth.table_axis) * truth.table_axis;
+    if (tilt_axis.norm() < 1e-6) tilt_axis = truth.table_axis.unitOrthogonal();
+    tilt_axis.normalize();
+    recorded.table_axis =
+        (Eigen::AngleAxisd(config.calib_axis_error_deg * kDegToRad, tilt_axis) * truth.table_axis)
+            .normalized();
+    scene.recorded_calibration = recorded;
+    return scene;
+}
+
+DepthImage RenderDepthFrame(const SyntheticScene& scene, double true_angle_rad,
+                            std::uint64_t frame_seed, int pose_index) {
+    const SyntheticStationConfig& cfg = scene.config;
+    const CameraIntrinsics& cam = cfg.camera;
+    const SensorNoiseParams& noise = scene.noise;
+    const int w = cam.width, h = cam.height;
+    const SyntheticRayCaster caster(cfg, true_angle_rad, pose_index);
+    const rnd::NormalQuantileTable& normal = rnd::NormalQuantiles();
+    // One 64-bit draw per pixel gives its lateral jitter (lanes 0, 1), its axial noise (lane 2)
+    // and its hole lottery (lane 3); the rarer artefacts draw from their own streams.
+    const std::uint64_t pixel_seed = rnd::Derive(frame_seed, kPixel);
+
+    // Pass 1: what each (laterally jittered) pixel ray sees.
+    const std::size_t n = static_cast<std::size_t>(w) * h;
+    std::vector<float> z(n, 0.0f), cos_inc(n, 1.0f);
+    const double lateral = noise.lateral_sigma_px;
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y) * w + x;
+            double u = x, v = y;
+            if (lateral > 0.0) {
+                const std::uint64_t bits = rnd::Bits(pixel_seed, i);
+                u += lateral * rnd::NormalFromLane(normal, bits, 0);
+                v += lateral * rnd::NormalFromLane(normal, bits, 1);
+            }
+            const SyntheticRayHit hit = caster.Cast(u, v);
+            z[i] = static_cast<float>(hit.z_m);
+            cos_inc[i] = static_cast<float>(hit.cos_incidence);
+        }
+    }
+
+    // Pass 2: the sensor's artefacts, then the 16-bit encoding.
+    DepthImage img(w, h);
+    const std::uint64_t dropout_seed = rnd::Derive(frame_seed, kDropout);
+    const double cos_dropout_start = std::cos(noise.dropout_start_deg * kDegToRad);
+    const double dropout_span = noise.dropout_full_deg - noise.dropout_start_deg;
+    const bool noisy_axis = noise.axial != NoiseModel::kNone;
+    const double focal_px = 0.5 * (cam.fx + cam.fy);
+    const double hole_threshold = noise.hole_fraction * 65536.0;
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y) * w + x;
+            if (z[i] <= 0.0f) continue;
+            const std::uint64_t bits = rnd::Bits(pixel_seed, i);
+            if (rnd::Lane16(bits, 3) < hole_threshold) continue;
+            const double cos_i = cos_inc[i];
+            if (cos_i < cos_dropout_start) {
+                const double incidence_deg = std::acos(cos_i) / kDegToRad;
+                const double p = dropout_span > 0.0
+                                     ? (incidence_deg - noise.dropout_start_deg) / dropout_span
+                                     : 1.0;
+                if (rnd::Uniform(dropout_seed, i) < p) continue;
+            }
+            double depth = z[i];
+            if (noise.flying_pixel_probability > 0.0) {
+                depth = FlyingPixelDepth(z, w, h, x, y, noise, frame_seed);
+            }
+            if (noisy_axis) {
+                const double sigma = AxialSigma(noise, depth, std::acos(cos_i), focal_px);
+                depth += sigma * rnd::NormalFromLane(normal, bits, 2);
+            }
+            depth -= cfg.true_depth_offset_m;  // the sensor's bias: it reads short by the offset
+            if (noise.disparity_quantisation) depth = KinectQuantiseDepth(depth);
+            if (depth <= 0.0 || depth < noise.min_range_m || depth > noise.max_range_m) continue;
+            const double units = std::nearbyint(depth / cam.depth_unit_m);
+            // Beyond the 16-bit range there is no reading rather than a wrong one.
+            if (units > 65535.0) continue;
+            img.pixels[i] = static_cast<std::uint16_t>(std::max(1.0, units));
+        }
+    }
+    return img;
+}
+
+Result<Session> RenderSyntheticSession(const SyntheticStationConfig& config, int poses,
+                                       int frames) {
+    if (auto st = config.Validate(); !st) return st.error();
+    if (poses < 1 || poses > 360) return Bad("poses", "must be in 1..360");
+    if (frames < 1 || frames > kMaxFramesPerPose) {
+        return Bad("frames", "must be in 1.." + std::to_string(kMaxFramesPerPose));
+    }
+    if (config.moved_at_pose && *config.moved_at_pose >= poses) {
+        return Bad("moved_at_pose",
+                   "must be less than the number of poses (" + std::to_string(poses) + ")");
+    }
+    const SyntheticScene scene = MakeSyntheticScene(config);
+
+    Session session;
+    session.source = "synthetic";
+    session.camera = config.camera;
+    session.calibration = scene.recorded_calibration;
+    session.direction = TurntableDirection::kCcw;
+    session.ground_truth = SyntheticGroundTruth(config.box);
+    session.poses.resize(static_cast<std::size_t>(poses));
+    for (int p = 0; p < poses; ++p) {
+        SessionPose& pose = session.poses[static_cast<std::size_t>(p)];
+        pose.angle_deg = 360.0 * p / poses;
+        pose.frames.resize(static_cast<std::size_t>(frames));
+        for (int f = 0; f < frames; ++f) pose.frame_paths.push_back(SessionFramePath(p, f));
+    }
+
+    // Every frame has its own seed, so the split over threads cannot change a single pixel.
+    std::atomic<int> next{0};
+    const int total = poses * frames;
+    auto worker = [&] {
+        for (int task = next++; task < total; task = next++) {
+            const int p = task / frames, f = task % frames;
+            SessionPose& pose = session.poses[static_cast<std::size_t>(p)];
+            const double angle = SyntheticTrueAngleDeg(config, p, pose.angle_deg) * kDegToRad;
+            pose.frames[static_cast<std::size_t>(f)] =
+                RenderDepthFrame(scene, angle, SyntheticFrameSeed(config.seed, p, f), p);
+        }
+    };
+    std::vector<std::thread> threads;
+    for (int t = 1; t < kRenderThreads; ++t) threads.emplace_back(worker);
+    worker();
+    for (auto& t : threads) t.join();
+    return session;
+}
+
+}  // namespace boxd

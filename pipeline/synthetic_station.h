@@ -1,0 +1,97 @@
+#pragma once
+// The synthetic station (SPEC section 7): a box resting on a turntable disc with a floor below,
+// seen by a tilted depth camera, rendered by ray casting with a sensor noise model. It backs
+// `boxd synth` and the simulated camera driver, so it is a library function, not CLI code.
+
+#include <cstdint>
+#include <optional>
+
+#include "pipeline/result.h"
+#include "pipeline/sensor_noise.h"
+#include "pipeline/session.h"
+
+namespace boxd {
+
+// NoiseModel, NoiseModelName() and ParseNoiseModel() live in pipeline/sensor_noise.h.
+
+// Where the box stands on the table at pose 0, in the table frame (metres, degrees).
+struct SyntheticBox {
+    double length_m = 0.455;
+    double width_m = 0.33;
+    double height_m = 0.46;
+    double offset_x_m = 0.0;  // box centre relative to the axis, table frame
+    double offset_y_m = 0.0;
+    double yaw_deg = 0.0;  // rotation of the box about the table axis at pose 0
+};
+
+// The camera placement: it looks at a point on the axis `aim_height_m` above the table top,
+// from `distance_m` away, `elevation_deg` above the table plane, with no roll. The defaults put
+// the table axis at (0, -0.87, -0.5) in the camera frame, the table centre at about
+// (0, 0.22, 1.13) m, and keep a 0.46 m tall box and most of the disc in a 640x480 f=570 view.
+struct SyntheticCameraPose {
+    double distance_m = 1.0;
+    double elevation_deg = 30.0;
+    double aim_height_m = 0.25;
+};
+
+struct SyntheticStationConfig {
+    SyntheticBox box;
+    SyntheticCameraPose camera_pose;
+    CameraIntrinsics camera;         // 640x480, f = 570 by default
+    double disc_radius_m = 0.40;     // turntable disc
+    double disc_thickness_m = 0.03;  // visible rim of the disc
+    double floor_drop_m = 0.10;      // floor (bench) below the table top
+    NoiseModel noise = NoiseModel::kKinect;
+    // Optional: replaces DefaultSensorNoise(noise) (e.g. tests that switch one artefact off).
+    std::optional<SensorNoiseParams> sensor_noise;
+    std::uint64_t seed = 1;
+
+    // Errors of the real station that the recorded session does not know about.
+    double angle_error_deg = 0.3;  // sigma of the per-pose turntable angle error
+    double calib_center_error_m =
+        0.003;  // magnitude of the centre error in the recorded calibration
+    double calib_axis_error_deg =
+        0.3;  // magnitude of the axis tilt error in the recorded calibration
+    double true_depth_offset_m = 0.0;  // sensor bias: raw z = true z - offset (scale 1)
+    // Optional: the box is pushed by (dx, dy) and turned by dyaw from this pose on (OBJECT_MOVED
+    // tests).
+    std::optional<int> moved_at_pose;
+    double moved_dx_m = 0.05, moved_dy_m = 0.0, moved_dyaw_deg = 10.0;
+
+    // Returns an error naming the first invalid field, or Ok.
+    Status Validate() const;
+};
+
+// The true geometry of the station, derived from a config (also what the simulated camera uses).
+struct SyntheticScene {
+    SyntheticStationConfig config;
+    SensorNoiseParams noise;                  // config.sensor_noise or the noise model's default
+    StationCalibration true_calibration;      // exact centre/axis/depth offset
+    StationCalibration recorded_calibration;  // what the session claims (with the injected errors)
+};
+
+// Returns the scene of `config` (the calibration errors are drawn from config.seed).
+SyntheticScene MakeSyntheticScene(const SyntheticStationConfig& config);
+
+// Returns one raw depth frame of `scene` with the table turned by `true_angle_rad` (ccw, the
+// actual angle including any angle error), with the config's noise drawn from `frame_seed`.
+// Deterministic for the same inputs.
+DepthImage RenderDepthFrame(const SyntheticScene& scene, double true_angle_rad,
+                            std::uint64_t frame_seed, int pose_index = 0);
+
+// Returns the noise seed of frame `frame` of pose `pose` in a session rendered with `seed`.
+std::uint64_t SyntheticFrameSeed(std::uint64_t seed, int pose, int frame);
+
+// Returns the true table angle (degrees) of pose `pose` commanded to `commanded_deg`: the
+// commanded angle plus a seeded N(0, angle_error_deg) error (none for pose 0).
+double SyntheticTrueAngleDeg(const SyntheticStationConfig& config, int pose, double commanded_deg);
+
+// Returns the box's true size as a session reports it (length >= width).
+BoxDimensions SyntheticGroundTruth(const SyntheticBox& box);
+
+// Returns a whole session: `poses` poses evenly spaced over 360 degrees, `frames` raw frames
+// each, the recorded calibration, and the box's true size as ground truth. Poses render on two
+// threads; the result does not depend on it.
+Result<Session> RenderSyntheticSession(const SyntheticStationConfig& config, int poses, int frames);
+
+}  // namespace boxd
