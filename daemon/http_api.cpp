@@ -152,6 +152,13 @@ void HttpApi::Register(httplib::Server& server) {
 
     // Runs before routing (and before the body is read): the bearer token guards every POST.
     server.set_pre_routing_handler([this](const Request& req, Response& res) {
+        // A request without Content-Length or Transfer-Encoding has no body (RFC 9112 6.3), but
+        // httplib 0.11 would wait for the client to close the connection (what `curl -X POST`
+        // without data never does). Saying so in the headers makes it read an empty body. The
+        // Request is httplib's own non-const object, handed to us as const.
+        if (!req.has_header("Content-Length") && !req.has_header("Transfer-Encoding")) {
+            const_cast<Request&>(req).headers.emplace("Content-Length", "0");
+        }
         if (req.method != "POST" || config_.bearer_token.empty()) {
             return httplib::Server::HandlerResponse::Unhandled;
         }
