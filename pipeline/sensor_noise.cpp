@@ -4,14 +4,6 @@
 
 namespace boxd {
 
-namespace {
-
-constexpr double kKinectDisparityScale = -0.0030711016;
-constexpr double kKinectDisparityOffset = 3.3309495161;
-constexpr int kKinectMaxRawDisparity = 2046;  // 2047 marks "no reading" in the 11-bit stream
-
-}  // namespace
-
 const char* NoiseModelName(NoiseModel m) {
     switch (m) {
         case NoiseModel::kNone:
@@ -91,46 +83,16 @@ SensorNoiseParams DefaultSensorNoise(NoiseModel model) {
     return p;
 }
 
-double KinectAxialSigma(double z_m, double incidence_rad) {
-    const double max_theta = M_PI / 2.0 - 3.0 * M_PI / 180.0;
-    const double theta = std::min(std::abs(incidence_rad), max_theta);
-    const double dz = z_m - 0.4;
-    const double grazing = M_PI / 2.0 - theta;
-    return 0.0012 + 0.0019 * dz * dz +
-           0.0001 / std::sqrt(z_m) * theta * theta / (grazing * grazing);
-}
-
-double StereoAxialSigma(double z_m, double focal_px, double baseline_m, double subpixel) {
-    return z_m * z_m * subpixel / (focal_px * baseline_m);
-}
-
-double AxialSigma(const SensorNoiseParams& params, double z_m, double incidence_rad,
-                  double focal_px) {
-    switch (params.axial) {
-        case NoiseModel::kNone:
-            return 0.0;
-        case NoiseModel::kKinect:
-            return KinectAxialSigma(z_m, incidence_rad);
-        case NoiseModel::kRealSense:
-            return StereoAxialSigma(z_m, focal_px, params.stereo_baseline_m,
-                                    params.stereo_subpixel);
-    }
-    return 0.0;
-}
-
-double KinectRawDisparity(double z_m) {
-    return (1.0 / z_m - kKinectDisparityOffset) / kKinectDisparityScale;
-}
-
-double KinectDepthOfDisparity(int raw) {
-    if (raw < 0 || raw > kKinectMaxRawDisparity) return 0.0;
-    const double inverse = raw * kKinectDisparityScale + kKinectDisparityOffset;
-    return inverse > 0.0 ? 1.0 / inverse : 0.0;
-}
-
-double KinectQuantiseDepth(double z_m) {
-    if (!(z_m > 0.0)) return 0.0;
-    return KinectDepthOfDisparity(static_cast<int>(std::lround(KinectRawDisparity(z_m))));
+const KinectDepthTable& KinectDisparityDepths() {
+    static const KinectDepthTable table = [] {
+        KinectDepthTable t{};
+        for (int raw = 0; raw <= kKinectMaxRawDisparity; ++raw) {
+            const double inverse = raw * kKinectDisparityScale + kKinectDisparityOffset;
+            t[static_cast<std::size_t>(raw)] = inverse > 0.0 ? 1.0 / inverse : 0.0;
+        }
+        return t;
+    }();
+    return table;
 }
 
 }  // namespace boxd

@@ -3,6 +3,9 @@
 // the Kinect v1 disparity quantisation and the parameters of the other artefacts (lateral
 // jitter, flying pixels, grazing-angle dropouts, random holes, working range).
 
+#include <algorithm>
+#include <array>
+#include <cmath>
 #include <limits>
 #include <string>
 
@@ -40,26 +43,75 @@ struct SensorNoiseParams {
 // Returns the parameters of the sensor class `model` (kNone: an ideal sensor).
 SensorNoiseParams DefaultSensorNoise(NoiseModel model);
 
+// Kinect v1 disparity conversion constants (OpenKinect / ROS openni_camera).
+inline constexpr double kKinectDisparityScale = -0.0030711016;
+inline constexpr double kKinectDisparityOffset = 3.3309495161;
+inline constexpr int kKinectMaxRawDisparity = 2046;  // 2047 marks "no reading" in the stream
+
+// The formulas below are inline: the renderer evaluates them for every pixel of every frame.
+
 // Returns the Kinect v1 axial sigma (m) at z-depth `z_m` and incidence angle `incidence_rad`:
 // 0.0012 + 0.0019 (z - 0.4)^2 + 0.0001 / sqrt(z) * theta^2 / (pi/2 - theta)^2
 // (Nguyen, Izadi, Lovell, "Modeling Kinect sensor noise for improved 3D reconstruction and
 // tracking", 3DIMPVT 2012). The angle term is evaluated no closer than 3 degrees to grazing.
-double KinectAxialSigma(double z_m, double incidence_rad);
+inline double KinectAxialSigma(double z_m, double incidence_rad) {
+    const double max_theta = M_PI / 2.0 - 3.0 * M_PI / 180.0;
+    const double theta = std::min(std::abs(incidence_rad), max_theta);
+    const double dz = z_m - 0.4;
+    const double grazing = M_PI / 2.0 - theta;
+    return 0.0012 + 0.0019 * dz * dz +
+           0.0001 * theta * theta / (std::sqrt(z_m) * grazing * grazing);
+}
 
 // Returns the axial sigma (m) of an active stereo camera, z^2 * subpixel / (f * baseline)
 // (the RealSense D400 depth-RMS-error formula; f in pixels).
-double StereoAxialSigma(double z_m, double focal_px, double baseline_m, double subpixel);
+inline double StereoAxialSigma(double z_m, double focal_px, double baseline_m, double subpixel) {
+    return z_m * z_m * subpixel / (focal_px * baseline_m);
+}
 
 // Returns the axial sigma (m) of `params` at `z_m` and `incidence_rad` (0 for kNone).
-double AxialSigma(const SensorNoiseParams& params, double z_m, double incidence_rad,
-                  double focal_px);
+inline double AxialSigma(const SensorNoiseParams& params, double z_m, double incidence_rad,
+                         double focal_px) {
+    switch (params.axial) {
+        case NoiseModel::kNone:
+            return 0.0;
+        case NoiseModel::kKinect:
+            return KinectAxialSigma(z_m, incidence_rad);
+        case NoiseModel::kRealSense:
+            return StereoAxialSigma(z_m, focal_px, params.stereo_baseline_m,
+                                    params.stereo_subpixel);
+    }
+    return 0.0;
+}
 
 // Kinect v1 11-bit disparity: z = 1 / (raw * -0.0030711016 + 3.3309495161) (the OpenKinect /
 // ROS openni_camera depth conversion). Returns the raw disparity of `z_m`, not rounded.
-double KinectRawDisparity(double z_m);
+inline double KinectRawDisparity(double z_m) {
+    constexpr double kInverseScale = 1.0 / kKinectDisparityScale;
+    return (1.0 / z_m - kKinectDisparityOffset) * kInverseScale;
+}
+
+// The z-depth of every raw disparity 0..2046 (0 where the formula gives none).
+using KinectDepthTable = std::array<double, kKinectMaxRawDisparity + 1>;
+// Returns the table of z-depths of the raw disparities (built once).
+const KinectDepthTable& KinectDisparityDepths();
+
 // Returns the z-depth of integer raw disparity `raw`, or 0 where the formula gives no depth.
-double KinectDepthOfDisparity(int raw);
-// Returns `z_m` snapped to the nearest 11-bit disparity level, or 0 if it has none.
-double KinectQuantiseDepth(double z_m);
+inline double KinectDepthOfDisparity(int raw) {
+    if (raw < 0 || raw > kKinectMaxRawDisparity) return 0.0;
+    return KinectDisparityDepths()[static_cast<std::size_t>(raw)];
+}
+
+// Returns `z_m` snapped to the nearest 11-bit disparity level, or 0 if it has none; `levels` is
+// KinectDisparityDepths() (passed in so that per-pixel callers fetch it once).
+inline double KinectQuantiseDepth(double z_m, const KinectDepthTable& levels) {
+    if (!(z_m > 0.0)) return 0.0;
+    const double raw = KinectRawDisparity(z_m);
+    if (!(raw > -0.5 && raw < kKinectMaxRawDisparity + 0.5)) return 0.0;
+    return levels[static_cast<std::size_t>(std::lround(raw))];
+}
+inline double KinectQuantiseDepth(double z_m) {
+    return KinectQuantiseDepth(z_m, KinectDisparityDepths());
+}
 
 }  // namespace boxd

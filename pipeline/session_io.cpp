@@ -312,6 +312,7 @@ Status WriteSession(const Session& session, const fs::path& dir) {
     if (ec) return Error{"IO_ERROR", dir.string() + ": cannot create folder: " + ec.message()};
 
     json poses = json::array();
+    std::vector<std::pair<fs::path, const DepthImage*>> pngs;
     for (std::size_t i = 0; i < session.poses.size(); ++i) {
         const SessionPose& p = session.poses[i];
         json frames = json::array();
@@ -323,15 +324,28 @@ Status WriteSession(const Session& session, const fs::path& dir) {
             }
             const fs::path file = dir / rel;
             fs::create_directories(file.parent_path(), ec);
-            const DepthImage& img = p.frames[k];
-            const cv::Mat mat(img.height, img.width, CV_16UC1,
-                              const_cast<std::uint16_t*>(img.pixels.data()));
-            if (!cv::imwrite(file.string(), mat, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
-                return Error{"IO_ERROR", file.string() + ": cannot write PNG"};
-            }
+            pngs.emplace_back(file, &p.frames[k]);
             frames.push_back(rel);
         }
         poses.push_back({{"angle_deg", p.angle_deg}, {"frames", frames}});
+    }
+    // PNG encoding dominates writing a session: two threads, like LoadFrames.
+    std::vector<std::optional<Error>> errors(pngs.size());
+    auto encode = [&](std::size_t begin, std::size_t step) {
+        for (std::size_t j = begin; j < pngs.size(); j += step) {
+            const auto& [file, img] = pngs[j];
+            const cv::Mat mat(img->height, img->width, CV_16UC1,
+                              const_cast<std::uint16_t*>(img->pixels.data()));
+            if (!cv::imwrite(file.string(), mat, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
+                errors[j] = Error{"IO_ERROR", file.string() + ": cannot write PNG"};
+            }
+        }
+    };
+    std::thread helper(encode, 1, 2);
+    encode(0, 2);
+    helper.join();
+    for (const auto& e : errors) {
+        if (e) return *e;
     }
     const auto& c = session.camera;
     const auto& cal = session.calibration;

@@ -258,8 +258,11 @@ DepthImage RenderDepthFrame(const SyntheticScene& scene, double true_angle_rad,
     const double cos_dropout_start = std::cos(noise.dropout_start_deg * kDegToRad);
     const double dropout_span = noise.dropout_full_deg - noise.dropout_start_deg;
     const bool noisy_axis = noise.axial != NoiseModel::kNone;
+    const bool needs_angle = noise.axial == NoiseModel::kKinect;  // its sigma depends on incidence
     const double focal_px = 0.5 * (cam.fx + cam.fy);
     const double hole_threshold = noise.hole_fraction * 65536.0;
+    const double inverse_unit = 1.0 / cam.depth_unit_m;
+    const KinectDepthTable& kinect_levels = KinectDisparityDepths();
     for (int y = 0; y < h; ++y) {
         for (int x = 0; x < w; ++x) {
             const std::size_t i = static_cast<std::size_t>(y) * w + x;
@@ -267,8 +270,10 @@ DepthImage RenderDepthFrame(const SyntheticScene& scene, double true_angle_rad,
             const std::uint64_t bits = rnd::Bits(pixel_seed, i);
             if (rnd::Lane16(bits, 3) < hole_threshold) continue;
             const double cos_i = cos_inc[i];
+            const double incidence =
+                needs_angle || cos_i < cos_dropout_start ? std::acos(cos_i) : 0.0;
             if (cos_i < cos_dropout_start) {
-                const double incidence_deg = std::acos(cos_i) / kDegToRad;
+                const double incidence_deg = incidence / kDegToRad;
                 const double p = dropout_span > 0.0
                                      ? (incidence_deg - noise.dropout_start_deg) / dropout_span
                                      : 1.0;
@@ -279,13 +284,13 @@ DepthImage RenderDepthFrame(const SyntheticScene& scene, double true_angle_rad,
                 depth = FlyingPixelDepth(z, w, h, x, y, noise, frame_seed);
             }
             if (noisy_axis) {
-                const double sigma = AxialSigma(noise, depth, std::acos(cos_i), focal_px);
+                const double sigma = AxialSigma(noise, depth, incidence, focal_px);
                 depth += sigma * rnd::NormalFromLane(normal, bits, 2);
             }
             depth -= cfg.true_depth_offset_m;  // the sensor's bias: it reads short by the offset
-            if (noise.disparity_quantisation) depth = KinectQuantiseDepth(depth);
+            if (noise.disparity_quantisation) depth = KinectQuantiseDepth(depth, kinect_levels);
             if (depth <= 0.0 || depth < noise.min_range_m || depth > noise.max_range_m) continue;
-            const double units = std::nearbyint(depth / cam.depth_unit_m);
+            const double units = std::nearbyint(depth * inverse_unit);
             // Beyond the 16-bit range there is no reading rather than a wrong one.
             if (units > 65535.0) continue;
             img.pixels[i] = static_cast<std::uint16_t>(std::max(1.0, units));

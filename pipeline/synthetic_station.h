@@ -48,13 +48,12 @@ struct SyntheticStationConfig {
 
     // Errors of the real station that the recorded session does not know about.
     double angle_error_deg = 0.3;  // sigma of the per-pose turntable angle error
-    double calib_center_error_m =
-        0.003;  // magnitude of the centre error in the recorded calibration
-    double calib_axis_error_deg =
-        0.3;  // magnitude of the axis tilt error in the recorded calibration
+    // Magnitudes of the centre error and the axis tilt in the recorded calibration.
+    double calib_center_error_m = 0.003;
+    double calib_axis_error_deg = 0.3;
     double true_depth_offset_m = 0.0;  // sensor bias: raw z = true z - offset (scale 1)
-    // Optional: the box is pushed by (dx, dy) and turned by dyaw from this pose on (OBJECT_MOVED
-    // tests).
+    // Optional: the box is pushed by (dx, dy) on the table top and turned by dyaw from this pose
+    // on (for OBJECT_MOVED tests).
     std::optional<int> moved_at_pose;
     double moved_dx_m = 0.05, moved_dy_m = 0.0, moved_dyaw_deg = 10.0;
 

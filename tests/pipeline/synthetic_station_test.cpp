@@ -315,6 +315,39 @@ TEST(SensorNoise, HolesAppearAtTheConfiguredRate) {
     EXPECT_NEAR(static_cast<double>(lost) / hit, 0.05, 0.005);
 }
 
+TEST(SensorNoise, FlyingPixelsMixDepthsAcrossJumpsOnly) {
+    SyntheticStationConfig c = ExactStation();
+    SensorNoiseParams p;  // flying pixels only, at every jump
+    p.flying_pixel_probability = 1.0;
+    c.sensor_noise = p;
+    const DepthImage exact = RenderDepthFrame(MakeSyntheticScene(ExactStation()), 0.4, 9, 0);
+    const DepthImage flying = RenderDepthFrame(MakeSyntheticScene(c), 0.4, 9, 0);
+    const double jump_units = p.flying_pixel_min_jump_m / c.camera.depth_unit_m;
+    int mixed = 0;
+    for (int y = 1; y + 1 < exact.height; ++y) {
+        for (int x = 1; x + 1 < exact.width; ++x) {
+            const int e = exact.at(x, y), f = flying.at(x, y);
+            ASSERT_EQ(f == 0, e == 0);
+            if (std::abs(f - e) <= 1) continue;
+            ++mixed;
+            // A changed pixel lies between its own depth and a neighbour's across a jump.
+            int lo = e, hi = e;
+            bool jump = false;
+            for (auto [dx, dy] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+                const int n = exact.at(x + dx, y + dy);
+                if (n == 0 || std::abs(n - e) < jump_units) continue;
+                jump = true;
+                lo = std::min(lo, n);
+                hi = std::max(hi, n);
+            }
+            ASSERT_TRUE(jump) << "pixel " << x << "," << y << " is not at a depth jump";
+            EXPECT_GE(f, lo - 1);
+            EXPECT_LE(f, hi + 1);
+        }
+    }
+    EXPECT_GT(mixed, 500);  // the box outline against the disc and the floor
+}
+
 TEST(SensorNoise, KinectDropsGrazingSurfaces) {
     SyntheticStationConfig c;
     c.camera_pose.elevation_deg = 8.0;  // the disc top is seen at about 80-85 degrees
