@@ -33,8 +33,5 @@ void AddCalibrate(CLI::App& app, Runner& run) {
 void AddRecord(CLI::App& app, Runner& run) {
     AddStub(app, run, "record", "Drive the station once and write a session");
 }
-void AddSimTurntable(CLI::App& app, Runner& run) {
-    AddStub(app, run, "sim-turntable", "Run a simulated Modbus turntable");
-}
 
 }  // namespace boxd::cli

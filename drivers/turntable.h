@@ -82,12 +82,16 @@ struct TurntableConfig {
     int stop_bits = 1;
     int slave_id = 1;  // 1..247
 
-    int response_timeout_ms = 300;     // per Modbus transaction (libmodbus response timeout)
-    int retries = 2;                   // extra attempts of a failed transaction (reconnecting)
-    int retry_delay_ms = 50;           // pause before a retry
-    int poll_interval_ms = 20;         // status polling while a move runs
-    int move_timeout_ms = 20000;       // from the move command to "in position"
-    int home_timeout_ms = 30000;       // from the home command to "homed and in position"
+    int response_timeout_ms = 300;  // per Modbus transaction (libmodbus response timeout)
+    int retries = 2;                // extra attempts of a failed transaction (reconnecting)
+    int retry_delay_ms = 50;        // pause before a retry
+    int poll_interval_ms = 20;      // status polling while a move runs
+    int move_timeout_ms = 20000;    // from the move command to "in position"
+    int home_timeout_ms = 30000;    // from the home command to "homed and at rest"
+    int stop_timeout_ms = 5000;     // from the stop command to "not moving"
+    // A drive may still show the previous move's "in position" right after a new command;
+    // an in-position state off the target only counts as final after this long.
+    int in_position_grace_ms = 250;
     double angle_tolerance_deg = 0.5;  // |reached - target| allowed after a move
     double speed_dps = 60.0;           // written to the speed register before each move
     std::string direction = "ccw";     // session "turntable.direction": ccw | cw

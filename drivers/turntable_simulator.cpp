@@ -1,0 +1,476 @@
+#include "drivers/turntable_simulator.h"
+
+#include <arpa/inet.h>
+#include <modbus/modbus.h>
+#include <netinet/in.h>
+#include <spdlog/spdlog.h>
+#include <sys/select.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "drivers/simulated_drive.h"
+#include "drivers/turntable_profile.h"
+
+namespace boxd {
+
+namespace {
+
+// The default register map of SPEC section 8, which the simulator serves.
+const TurntableProfile kProfile;
+constexpr int kRegisterCount = 110;
+constexpr int kFirstSpecialRegister = 100;
+constexpr int kPollSliceMs = 10;
+
+struct FaultName {
+    SimulatedFault fault;
+    const char* name;
+};
+constexpr FaultName kFaultNames[] = {
+    {SimulatedFault::kNone, "none"},           {SimulatedFault::kStall, "stall"},
+    {SimulatedFault::kTimeout, "timeout"},     {SimulatedFault::kDrop, "drop"},
+    {SimulatedFault::kException, "exception"}, {SimulatedFault::kSlow, "slow"}};
+
+Error SimError(const std::string& message) { return Error{"INVALID_INPUT", message}; }
+
+// One register write found in a request: the registers it sets.
+struct RegisterWrite {
+    int address = 0;
+    std::vector<uint16_t> values;
+};
+
+// Decodes the register writes and the register range a request touches (functions 3, 6, 16 and
+// 23 of the Modbus Application Protocol v1.1b3, section 6). `header` is the ADU header length.
+struct DecodedRequest {
+    int function = 0;
+    int lowest_register = 0;  // lowest register read or written (0 when unknown)
+    std::vector<RegisterWrite> writes;
+};
+
+uint16_t Word(const uint8_t* p) { return static_cast<uint16_t>((p[0] << 8) | p[1]); }
+
+DecodedRequest Decode(const uint8_t* req, int length, int header) {
+    DecodedRequest d;
+    if (length < header + 5) return d;
+    const uint8_t* pdu = req + header;
+    d.function = pdu[0];
+    const int address = Word(pdu + 1);
+    d.lowest_register = address;
+    if (d.function == MODBUS_FC_WRITE_SINGLE_REGISTER) {
+        d.writes.push_back({address, {Word(pdu + 3)}});
+    } else if (d.function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS && length >= header + 6) {
+        const int count = Word(pdu + 3);
+        if (length >= header + 6 + 2 * count) {
+            RegisterWrite w{address, {}};
+            for (int i = 0; i < count; ++i) w.values.push_back(Word(pdu + 6 + 2 * i));
+            d.writes.push_back(std::move(w));
+        }
+    } else if (d.function == MODBUS_FC_WRITE_AND_READ_REGISTERS && length >= header + 10) {
+        const int write_address = Word(pdu + 5);
+        const int count = Word(pdu + 7);
+        if (length >= header + 10 + 2 * count) {
+            RegisterWrite w{write_address, {}};
+            for (int i = 0; i < count; ++i) w.values.push_back(Word(pdu + 10 + 2 * i));
+            d.writes.push_back(std::move(w));
+            d.lowest_register = std::min(address, write_address);
+        }
+    }
+    return d;
+}
+
+bool Touches(const RegisterWrite& w, int lo, int hi) {
+    const int last = w.address + static_cast<int>(w.values.size()) - 1;
+    return w.address <= hi && last >= lo;
+}
+
+// Returns the value `w` writes to `address`, or -1.
+int ValueAt(const RegisterWrite& w, int address) {
+    const int i = address - w.address;
+    if (i < 0 || i >= static_cast<int>(w.values.size())) return -1;
+    return w.values[static_cast<std::size_t>(i)];
+}
+
+}  // namespace
+
+Result<SimulatedFault> ParseSimulatedFault(const std::string& name) {
+    for (const auto& f : kFaultNames) {
+        if (name == f.name) return f.fault;
+    }
+    return SimError(
+        "sim-turntable.fault: must be none, stall, timeout, drop, exception or slow, "
+        "got '" +
+        name + "'");
+}
+
+const char* SimulatedFaultName(SimulatedFault fault) {
+    for (const auto& f : kFaultNames) {
+        if (fault == f.fault) return f.name;
+    }
+    return "unknown";
+}
+
+Status TurntableSimulatorConfig::Validate() const {
+    if (!(max_speed_dps > 0.0) || max_speed_dps > 6553.5) {
+        return SimError("sim-turntable.max_speed_dps: must be in (0, 6553.5] °/s");
+    }
+    if (settle_ms < 0 || settle_ms > 65535) {
+        return SimError("sim-turntable.settle_ms: must be 0..65535");
+    }
+    if (!std::isfinite(initial_angle_deg) || std::abs(initial_angle_deg) > 1e6) {
+        return SimError("sim-turntable.initial_angle_deg: must be a finite angle");
+    }
+    if (fault_after_moves < 0 || fault_after_moves > 65535) {
+        return SimError("sim-turntable.fault_after_moves: must be 0..65535");
+    }
+    if (slow_reply_ms < 0 || slow_reply_ms > 65535) {
+        return SimError("sim-turntable.slow_reply_ms: must be 0..65535");
+    }
+    if (slave_id < 1 || slave_id > 247) return SimError("sim-turntable.slave_id: must be 1..247");
+    return OkStatus();
+}
+
+struct TurntableSimulator::Impl {
+    explicit Impl(const TurntableSimulatorConfig& c) : config(c), drive(c.initial_angle_deg) {}
+
+    TurntableSimulatorConfig config;
+    SimulatedDrive drive;
+    modbus_t* ctx = nullptr;
+    modbus_mapping_t* map = nullptr;
+    bool rtu = false;
+    int listen_fd = -1;
+    int port = 0;
+    std::vector<int> clients;
+
+    int moves_since_arm = 0;    // move commands since the fault was (re)armed
+    bool move_faulted = false;  // the move in progress is a faulted one
+    bool dropped_this_move = false;
+    uint16_t move_count = 0;
+    uint16_t stop_count = 0;
+    uint16_t home_count = 0;
+    uint16_t connection_count = 0;
+
+    uint16_t* regs() { return map->tab_registers; }
+
+    bool FaultActive(SimulatedFault f) const {
+        return move_faulted && config.fault == f && drive.busy();
+    }
+
+    double SpeedDps() const {
+        const double commanded = map->tab_registers[kProfile.speed_register] / 10.0;
+        return commanded > 0.0 ? std::min(commanded, config.max_speed_dps) : config.max_speed_dps;
+    }
+
+    // Brings the model up to now and writes it into the status and special registers.
+    void Publish() {
+        drive.Advance(SimClock::now());
+        const DriveStatus& s = drive.status();
+        if (move_faulted && !drive.busy()) move_faulted = false;
+        uint16_t status = 0;
+        if (s.homed) status |= 1u << kProfile.homed_bit;
+        if (s.moving) status |= 1u << kProfile.moving_bit;
+        if (s.in_position) status |= 1u << kProfile.in_position_bit;
+        if (s.fault) status |= 1u << kProfile.fault_bit;
+        regs()[kProfile.status_register] = status;
+        SplitInt32(static_cast<int32_t>(std::lround(s.angle_deg * 100.0)), WordOrder::kHighFirst,
+                   &regs()[kProfile.angle_register]);
+        regs()[kProfile.fault_code_register] = static_cast<uint16_t>(s.fault_code);
+        regs()[kSimFaultModeRegister] = static_cast<uint16_t>(config.fault);
+        regs()[kSimFaultAfterMovesRegister] = static_cast<uint16_t>(config.fault_after_moves);
+        regs()[kSimSettleMsRegister] = static_cast<uint16_t>(config.settle_ms);
+        regs()[kSimMaxSpeedRegister] =
+            static_cast<uint16_t>(std::lround(config.max_speed_dps * 10));
+        regs()[kSimSlowReplyMsRegister] = static_cast<uint16_t>(config.slow_reply_ms);
+        regs()[kSimMoveCountRegister] = move_count;
+        regs()[kSimStopCountRegister] = stop_count;
+        regs()[kSimConnectionCountRegister] = connection_count;
+        regs()[kSimHomeCountRegister] = home_count;
+    }
+
+    // Returns the exception a request must get instead of its normal reply, or 0.
+    int ExceptionFor(const DecodedRequest& d) {
+        for (const auto& w : d.writes) {
+            if (Touches(w, kProfile.status_register, kProfile.fault_code_register) ||
+                Touches(w, kSimMoveCountRegister, kSimHomeCountRegister)) {
+                return MODBUS_EXCEPTION_ILLEGAL_DATA_ADDRESS;
+            }
+            const int command = ValueAt(w, kProfile.command_register);
+            if (command > kProfile.command_clear_fault) {
+                return MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE;
+            }
+            const int mode = ValueAt(w, kSimFaultModeRegister);
+            if (mode > static_cast<int>(SimulatedFault::kSlow)) {
+                return MODBUS_EXCEPTION_ILLEGAL_DATA_VALUE;
+            }
+            if (command == kProfile.command_move && config.fault == SimulatedFault::kException &&
+                NextMoveFaulted()) {
+                ++moves_since_arm;
+                ++move_count;
+                spdlog::info("sim-turntable: injected fault: exception reply to move command");
+                return MODBUS_EXCEPTION_SLAVE_OR_SERVER_FAILURE;
+            }
+        }
+        return 0;
+    }
+
+    bool NextMoveFaulted() const {
+        return config.fault != SimulatedFault::kNone && moves_since_arm >= config.fault_after_moves;
+    }
+
+    // Applies what a request wrote (after libmodbus stored it in the mapping).
+    void ApplyWrites(const DecodedRequest& d) {
+        for (const auto& w : d.writes) {
+            if (Touches(w, kFirstSpecialRegister, kSimSlowReplyMsRegister)) ApplySpecial(w);
+            if (ValueAt(w, kProfile.command_register) > 0) {
+                Execute(regs()[kProfile.command_register]);
+                regs()[kProfile.command_register] = 0;
+            }
+        }
+    }
+
+    void ApplySpecial(const RegisterWrite& w) {
+        if (int v = ValueAt(w, kSimFaultModeRegister); v >= 0) {
+            config.fault = static_cast<SimulatedFault>(v);
+            moves_since_arm = 0;
+        }
+        if (int v = ValueAt(w, kSimFaultAfterMovesRegister); v >= 0) {
+            config.fault_after_moves = v;
+            moves_since_arm = 0;
+        }
+        if (int v = ValueAt(w, kSimSettleMsRegister); v >= 0) config.settle_ms = v;
+        if (int v = ValueAt(w, kSimMaxSpeedRegister); v > 0) config.max_speed_dps = v / 10.0;
+        if (int v = ValueAt(w, kSimSlowReplyMsRegister); v >= 0) config.slow_reply_ms = v;
+        spdlog::info("sim-turntable: fault {} after {} moves, settle {} ms, top speed {} °/s",
+                     SimulatedFaultName(config.fault), config.fault_after_moves, config.settle_ms,
+                     config.max_speed_dps);
+    }
+
+    void Execute(int command) {
+        const auto now = SimClock::now();
+        if (command == kProfile.command_move) {
+            const double target =
+                JoinInt32(&regs()[kProfile.target_register], WordOrder::kHighFirst) / 100.0;
+            move_faulted = NextMoveFaulted();
+            ++moves_since_arm;
+            ++move_count;
+            dropped_this_move = false;
+            MoveMisbehaviour misbehaviour = MoveMisbehaviour::kNone;
+            if (move_faulted && config.fault == SimulatedFault::kStall) {
+                misbehaviour = MoveMisbehaviour::kStall;
+            } else if (move_faulted && config.fault == SimulatedFault::kTimeout) {
+                misbehaviour = MoveMisbehaviour::kNeverArrive;
+            }
+            spdlog::info(
+                "sim-turntable: move {} to {:.2f}° at {:.1f}°/s{}", move_count, target, SpeedDps(),
+                move_faulted ? std::string(" (fault: ") + SimulatedFaultName(config.fault) + ")"
+                             : std::string());
+            drive.Move(target, SpeedDps(), config.settle_ms, misbehaviour, now);
+        } else if (command == kProfile.command_home) {
+            ++home_count;
+            spdlog::info("sim-turntable: homing");
+            drive.Home(SpeedDps(), config.settle_ms, now);
+        } else if (command == kProfile.command_stop) {
+            ++stop_count;
+            spdlog::info("sim-turntable: stop");
+            drive.Stop(now);
+        } else if (command == kProfile.command_clear_fault) {
+            spdlog::info("sim-turntable: clear fault");
+            drive.ClearFault();
+        }
+    }
+
+    // Serves one request received on the current socket. Returns false when the connection
+    // is to be closed (an injected drop).
+    bool Handle(const uint8_t* req, int length) {
+        Publish();
+        const DecodedRequest d = Decode(req, length, modbus_get_header_length(ctx));
+        const bool drive_register = d.lowest_register < kFirstSpecialRegister;
+        if (drive_register && FaultActive(SimulatedFault::kDrop) && !dropped_this_move &&
+            d.writes.empty()) {
+            dropped_this_move = true;
+            spdlog::info("sim-turntable: injected fault: dropping the connection mid-move");
+            return false;
+        }
+        if (drive_register && config.fault == SimulatedFault::kSlow &&
+            (FaultActive(SimulatedFault::kSlow) || StartsFaultedMove(d))) {
+            spdlog::info("sim-turntable: injected fault: replying after {} ms",
+                         config.slow_reply_ms);
+            std::this_thread::sleep_for(std::chrono::milliseconds(config.slow_reply_ms));
+            Publish();
+        }
+        if (const int exception = ExceptionFor(d); exception != 0) {
+            modbus_reply_exception(ctx, req, static_cast<unsigned>(exception));
+            return true;
+        }
+        modbus_reply(ctx, req, length, map);
+        ApplyWrites(d);
+        Publish();
+        return true;
+    }
+
+    bool StartsFaultedMove(const DecodedRequest& d) const {
+        for (const auto& w : d.writes) {
+            if (ValueAt(w, kProfile.command_register) == kProfile.command_move) {
+                return NextMoveFaulted();
+            }
+        }
+        return false;
+    }
+
+    void CloseClient(std::size_t i) {
+        close(clients[i]);
+        clients.erase(clients.begin() + static_cast<std::ptrdiff_t>(i));
+    }
+
+    Status ServeTcpOnce() {
+        fd_set readable;
+        FD_ZERO(&readable);
+        FD_SET(listen_fd, &readable);
+        int max_fd = listen_fd;
+        for (int fd : clients) {
+            FD_SET(fd, &readable);
+            max_fd = std::max(max_fd, fd);
+        }
+        timeval timeout{0, kPollSliceMs * 1000};
+        const int n = select(max_fd + 1, &readable, nullptr, nullptr, &timeout);
+        if (n < 0) {
+            if (errno == EINTR) return OkStatus();
+            return Error{"INTERNAL", std::string("sim-turntable: select: ") + strerror(errno)};
+        }
+        Publish();
+        if (n == 0) return OkStatus();
+        if (FD_ISSET(listen_fd, &readable)) {
+            sockaddr_in peer{};
+            socklen_t len = sizeof(peer);
+            const int fd = accept(listen_fd, reinterpret_cast<sockaddr*>(&peer), &len);
+            if (fd >= 0) {
+                clients.push_back(fd);
+                ++connection_count;
+                spdlog::info("sim-turntable: client connected from {}:{}", inet_ntoa(peer.sin_addr),
+                             ntohs(peer.sin_port));
+            }
+        }
+        uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
+        for (std::size_t i = 0; i < clients.size();) {
+            const int fd = clients[i];
+            if (!FD_ISSET(fd, &readable)) {
+                ++i;
+                continue;
+            }
+            modbus_set_socket(ctx, fd);
+            const int rc = modbus_receive(ctx, query);
+            if (rc > 0 && Handle(query, rc)) {
+                ++i;
+            } else if (rc == 0) {
+                ++i;
+            } else {
+                if (rc < 0) spdlog::info("sim-turntable: client disconnected");
+                CloseClient(i);
+            }
+        }
+        return OkStatus();
+    }
+
+    Status ServeRtuOnce() {
+        const int fd = modbus_get_socket(ctx);
+        fd_set readable;
+        FD_ZERO(&readable);
+        FD_SET(fd, &readable);
+        timeval timeout{0, kPollSliceMs * 1000};
+        const int n = select(fd + 1, &readable, nullptr, nullptr, &timeout);
+        if (n < 0) {
+            if (errno == EINTR) return OkStatus();
+            return Error{"INTERNAL", std::string("sim-turntable: select: ") + strerror(errno)};
+        }
+        Publish();
+        if (n == 0) return OkStatus();
+        uint8_t query[MODBUS_RTU_MAX_ADU_LENGTH];
+        const int rc = modbus_receive(ctx, query);
+        if (rc > 0) {
+            // On a serial line a "dropped connection" is a reply that never comes.
+            Handle(query, rc);
+        } else if (rc < 0) {
+            spdlog::debug("sim-turntable: bad frame: {}", modbus_strerror(errno));
+            modbus_flush(ctx);
+        }
+        return OkStatus();
+    }
+};
+
+TurntableSimulator::TurntableSimulator(const TurntableSimulatorConfig& config)
+    : impl_(std::make_unique<Impl>(config)) {
+    impl_->map = modbus_mapping_new(0, 0, kRegisterCount, 0);
+    if (impl_->map) impl_->Publish();
+}
+
+TurntableSimulator::~TurntableSimulator() {
+    for (int fd : impl_->clients) close(fd);
+    if (impl_->listen_fd >= 0) close(impl_->listen_fd);
+    if (impl_->ctx) {
+        if (impl_->rtu) modbus_close(impl_->ctx);
+        modbus_free(impl_->ctx);
+    }
+    if (impl_->map) modbus_mapping_free(impl_->map);
+}
+
+Status TurntableSimulator::ListenTcp(const std::string& host, int port) {
+    if (auto st = impl_->config.Validate(); !st) return st;
+    if (!impl_->map) return Error{"INTERNAL", "sim-turntable: cannot allocate the registers"};
+    impl_->ctx = modbus_new_tcp(host.c_str(), port);
+    if (!impl_->ctx) {
+        return SimError("sim-turntable: bad listen address " + host + ":" + std::to_string(port));
+    }
+    impl_->listen_fd = modbus_tcp_listen(impl_->ctx, 8);
+    if (impl_->listen_fd < 0) {
+        return Error{"INTERNAL", "sim-turntable: cannot listen on " + host + ":" +
+                                     std::to_string(port) + ": " + modbus_strerror(errno)};
+    }
+    sockaddr_in bound{};
+    socklen_t len = sizeof(bound);
+    getsockname(impl_->listen_fd, reinterpret_cast<sockaddr*>(&bound), &len);
+    impl_->port = ntohs(bound.sin_port);
+    spdlog::info("sim-turntable: listening on {}:{} (Modbus TCP)", host, impl_->port);
+    return OkStatus();
+}
+
+int TurntableSimulator::port() const { return impl_->port; }
+
+Status TurntableSimulator::OpenRtu(const std::string& device, int baud, char parity, int data_bits,
+                                   int stop_bits) {
+    if (auto st = impl_->config.Validate(); !st) return st;
+    if (!impl_->map) return Error{"INTERNAL", "sim-turntable: cannot allocate the registers"};
+    impl_->rtu = true;
+    impl_->ctx = modbus_new_rtu(device.c_str(), baud, parity, data_bits, stop_bits);
+    if (!impl_->ctx) {
+        return SimError("sim-turntable: bad serial settings for " + device + ": " +
+                        modbus_strerror(errno));
+    }
+    modbus_set_slave(impl_->ctx, impl_->config.slave_id);
+    if (modbus_connect(impl_->ctx) == -1) {
+        return Error{"INTERNAL",
+                     "sim-turntable: cannot open " + device + ": " + modbus_strerror(errno)};
+    }
+    spdlog::info("sim-turntable: serving Modbus RTU on {} ({} baud, slave {})", device, baud,
+                 impl_->config.slave_id);
+    return OkStatus();
+}
+
+Status TurntableSimulator::Serve(const std::atomic<bool>& stop) {
+    if (!impl_->ctx) return Error{"INTERNAL", "sim-turntable: not listening"};
+    while (!stop.load()) {
+        auto st = impl_->rtu ? impl_->ServeRtuOnce() : impl_->ServeTcpOnce();
+        if (!st) return st;
+    }
+    spdlog::info("sim-turntable: stopping (table {})",
+                 impl_->drive.status().moving ? "was moving, stopped" : "at rest");
+    impl_->drive.Stop(SimClock::now());
+    return OkStatus();
+}
+
+}  // namespace boxd
