@@ -56,6 +56,11 @@ int RunSimTurntable(SimTurntableOptions o) {
         return FailBadInput("sim-turntable: --parity must be N, E or O");
     }
 
+    // Before the port is announced, so a client that stops the simulator at once gets a clean
+    // exit rather than the default action of the signal.
+    std::signal(SIGPIPE, SIG_IGN);
+    std::signal(SIGTERM, OnStopSignal);
+    std::signal(SIGINT, OnStopSignal);
     TurntableSimulator simulator(o.sim);
     Status opened = o.rtu_device.empty()
                         ? simulator.ListenTcp(o.host, o.port)
@@ -73,9 +78,6 @@ int RunSimTurntable(SimTurntableOptions o) {
                  o.sim.max_speed_dps, o.sim.settle_ms, SimulatedFaultName(o.sim.fault),
                  o.sim.fault_after_moves);
 
-    std::signal(SIGPIPE, SIG_IGN);
-    std::signal(SIGTERM, OnStopSignal);
-    std::signal(SIGINT, OnStopSignal);
     auto served = simulator.Serve(g_stop_requested);
     if (!served) {
         spdlog::error("{}", served.error().message);

@@ -50,7 +50,10 @@ protected:
         link.device = (dir_ / "host").string();
         link.baud = 115200;
         link.slave_id = 5;
-        link.response_timeout_ms = 100;
+        // Long enough to cover the simulator's start-up: a request sent before it listens
+        // waits in the pty and gets its reply late, which a short timeout would leave behind
+        // on the line for the next client.
+        link.response_timeout_ms = 3000;
         link.retries = 0;
         const auto start = SteadyClock::now();
         bool ready = false;

@@ -74,6 +74,9 @@ struct BadConfigCase {
     const char* field;
 };
 
+// Names the case by its field in test listings.
+void PrintTo(const BadConfigCase& c, std::ostream* os) { *os << c.field; }
+
 class TurntableConfigErrors : public ::testing::TestWithParam<BadConfigCase> {};
 
 TEST_P(TurntableConfigErrors, NameTheField) {
