@@ -143,6 +143,7 @@ int RunSynth(const SynthOptions& o) {
 
     auto session = RenderSyntheticSession(*config, o.poses, o.frames);
     if (!session) return FailBadInput(session.error().message);
+    const auto rendered = std::chrono::steady_clock::now();
     spdlog::info("synth: rendered {} poses x {} frames ({} noise, seed {})", o.poses, o.frames,
                  o.noise, o.seed);
     if (auto st = WriteSession(*session, o.out); !st) {
@@ -151,9 +152,10 @@ int RunSynth(const SynthOptions& o) {
     }
     RemoveStaleFrames(o.out, *previous, *session);
 
-    const auto elapsed = std::chrono::duration_cast<std::chrono::milliseconds>(
-                             std::chrono::steady_clock::now() - start)
-                             .count();
+    const auto end = std::chrono::steady_clock::now();
+    auto ms = [](auto d) {
+        return std::chrono::duration_cast<std::chrono::milliseconds>(d).count();
+    };
     std::error_code ec;
     const fs::path abs = fs::absolute(o.out, ec);
     const BoxDimensions& gt = *session->ground_truth;
@@ -165,7 +167,9 @@ int RunSynth(const SynthOptions& o) {
         {"seed", o.seed},
         {"ground_truth",
          {{"length_m", gt.length_m}, {"width_m", gt.width_m}, {"height_m", gt.height_m}}},
-        {"elapsed_ms", elapsed}};
+        {"elapsed_ms", ms(end - start)},
+        {"render_ms", ms(rendered - start)},
+        {"write_ms", ms(end - rendered)}};
     std::printf("%s\n", summary.dump().c_str());
     return kExitOk;
 }
