@@ -11,8 +11,13 @@ using nlohmann::json;
 
 namespace {
 
-// Rounds to 0.1 mm / 0.1 ms-class precision so the JSON stays readable and stable.
-double Round(double v, double step) { return std::round(v / step) * step; }
+// Rounds to `step` (a power of ten) so the JSON stays readable and stable. Dividing by the exact
+// integer 1/step (rather than multiplying by the inexact step) yields the double nearest the
+// decimal, which the JSON writer prints in its short form ("0.45996", not "0.45996000000000004").
+double Round(double v, double step) {
+    const double scale = std::round(1.0 / step);
+    return std::round(v * scale) / scale;
+}
 
 json Array3(const std::array<double, 3>& a, double step) {
     return json::array({Round(a[0], step), Round(a[1], step), Round(a[2], step)});
