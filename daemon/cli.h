@@ -25,6 +25,7 @@ void AddCalibrate(CLI::App& app, Runner& run);
 void AddRecord(CLI::App& app, Runner& run);
 void AddSynth(CLI::App& app, Runner& run);
 void AddSimTurntable(CLI::App& app, Runner& run);
+void AddDevices(CLI::App& app, Runner& run);
 
 // Prints "boxd: error: <message>" as one line on stderr and returns kExitBadInput.
 int FailBadInput(const std::string& message);

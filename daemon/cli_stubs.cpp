@@ -30,8 +30,5 @@ void AddMeasure(CLI::App& app, Runner& run) {
 void AddCalibrate(CLI::App& app, Runner& run) {
     AddStub(app, run, "calibrate", "Estimate the station calibration from a reference box");
 }
-void AddRecord(CLI::App& app, Runner& run) {
-    AddStub(app, run, "record", "Drive the station once and write a session");
-}
 
 }  // namespace boxd::cli

@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
     AddRecord(app, run);
     AddSynth(app, run);
     AddSimTurntable(app, run);
+    AddDevices(app, run);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

@@ -1,0 +1,264 @@
+// The capture loop with real pieces: the simulated camera rendering the synthetic station at the
+// angle reported by a ModbusTurntable driving an in-process TurntableSimulator over Modbus TCP
+// on loopback (fault injection included).
+#include "drivers/capture_loop.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
+
+#include "drivers/modbus_client.h"
+#include "drivers/simulated_camera.h"
+#include "drivers/turntable.h"
+#include "drivers/turntable_simulator.h"
+
+namespace boxd {
+namespace {
+
+using std::chrono::milliseconds;
+
+// A TurntableSimulator serving on a thread for the test's lifetime.
+class SimulatorThread {
+public:
+    explicit SimulatorThread(TurntableSimulatorConfig config) : sim_(config) {
+        const Status st = sim_.ListenTcp("127.0.0.1", 0);
+        EXPECT_TRUE(st.ok()) << st.error().message;
+        thread_ = std::thread([this] { served_ = sim_.Serve(stop_); });
+    }
+    ~SimulatorThread() {
+        stop_.store(true);
+        thread_.join();
+    }
+    int port() const { return sim_.port(); }
+
+    // Returns a special register of the simulator read over a separate connection.
+    int ReadRegister(int address) const {
+        ModbusLinkConfig link;
+        link.host = "127.0.0.1";
+        link.port = port();
+        ModbusClient client(link);
+        auto regs = client.ReadRegisters(address, 1);
+        EXPECT_TRUE(regs.ok()) << regs.error().message;
+        return regs.ok() ? (*regs)[0] : -1;
+    }
+
+private:
+    TurntableSimulator sim_;
+    std::atomic<bool> stop_{false};
+    Status served_ = OkStatus();
+    std::thread thread_;
+};
+
+TurntableSimulatorConfig FastSimulator() {
+    TurntableSimulatorConfig c;
+    c.max_speed_dps = 720.0;
+    c.settle_ms = 10;
+    return c;
+}
+
+std::unique_ptr<Turntable> Connect(int port, double speed_dps = 720.0) {
+    TurntableConfig c;
+    c.driver = "modbus-tcp";
+    c.host = "127.0.0.1";
+    c.port = port;
+    c.speed_dps = speed_dps;
+    c.move_timeout_ms = 20000;
+    auto table = MakeTurntable(c);
+    EXPECT_TRUE(table.ok()) << table.error().message;
+    return table.ok() ? std::move(table).value() : nullptr;
+}
+
+// A small, quick-to-render simulated camera looking at the default box.
+SimulatedCameraConfig SmallCamera() {
+    SimulatedCameraConfig c;
+    c.station.camera.width = 160;
+    c.station.camera.height = 120;
+    c.station.camera.fx = c.station.camera.fy = 142.5;
+    c.station.camera.cx = 79.5;
+    c.station.camera.cy = 59.5;
+    c.station.seed = 11;
+    return c;
+}
+
+AngleSource AngleOf(Turntable& table) {
+    return [&table] { return table.CurrentAngleDeg(); };
+}
+
+CaptureConfig QuickCapture(int poses) {
+    CaptureConfig c;
+    c.poses = poses;
+    c.frames_per_pose = 2;
+    c.drop_frames = 1;
+    c.settle_ms = 0;
+    c.grab_timeout_ms = 1000;
+    return c;
+}
+
+TEST(CaptureLoop, CapturesEveryPoseWithRawFrames) {
+    SimulatorThread sim(FastSimulator());
+    auto table = Connect(sim.port());
+    ASSERT_TRUE(table);
+    SimulatedCamera camera(SmallCamera(), AngleOf(*table));
+    ASSERT_TRUE(camera.Open().ok());
+
+    CaptureStation station;
+    station.calibration = camera.Scene().recorded_calibration;
+    std::vector<std::pair<int, int>> progress;
+    std::vector<std::size_t> handed_over;
+    CaptureCallbacks cb;
+    cb.on_progress = [&](int k, int n) { progress.emplace_back(k, n); };
+    cb.on_pose = [&](std::size_t i, const SessionPose& pose) {
+        EXPECT_EQ(pose.frames.size(), 2u);
+        handed_over.push_back(i);
+    };
+    auto session = CaptureSession(*table, camera, QuickCapture(3), station, cb);
+    ASSERT_TRUE(session.ok()) << session.error().message;
+
+    EXPECT_EQ(session->source, "simulated");
+    EXPECT_EQ(session->camera.width, 160);
+    EXPECT_TRUE(session->calibration.table_center_m.isApprox(station.calibration.table_center_m));
+    ASSERT_EQ(session->poses.size(), 3u);
+    const double expected[] = {0.0, 120.0, 240.0};
+    for (std::size_t i = 0; i < 3; ++i) {
+        EXPECT_DOUBLE_EQ(session->poses[i].angle_deg, expected[i]);
+        ASSERT_EQ(session->poses[i].frames.size(), 2u);
+        EXPECT_EQ(session->poses[i].frame_paths[1], SessionFramePath(i, 1));
+        EXPECT_EQ(session->poses[i].frames[0].width, 160);
+    }
+    // Views of a turned box differ; two frames of one pose differ only by noise.
+    const auto& a = session->poses[0].frames[0].pixels;
+    const auto& b = session->poses[1].frames[0].pixels;
+    EXPECT_NE(a, b);
+    EXPECT_EQ(handed_over, (std::vector<std::size_t>{0, 1, 2}));
+    ASSERT_EQ(progress.size(), 4u);
+    EXPECT_EQ(progress.front(), std::make_pair(0, 3));
+    EXPECT_EQ(progress.back(), std::make_pair(3, 3));
+    auto angle = table->CurrentAngleDeg();
+    ASSERT_TRUE(angle.ok());
+    EXPECT_NEAR(*angle, 240.0, 0.5);
+}
+
+TEST(CaptureLoop, CancellationStopsTheTableMidMove) {
+    SimulatorThread sim(FastSimulator());
+    auto table = Connect(sim.port(), 30.0);  // 0 -> 180 takes 6 s at 30 °/s
+    ASSERT_TRUE(table);
+    SimulatedCamera camera(SmallCamera(), AngleOf(*table));
+    ASSERT_TRUE(camera.Open().ok());
+
+    std::atomic<bool> cancel{false};
+    std::thread canceller;
+    CaptureCallbacks cb;
+    cb.cancel = &cancel;
+    cb.on_progress = [&](int k, int) {
+        if (k == 1) {
+            canceller = std::thread([&] {
+                std::this_thread::sleep_for(milliseconds(500));
+                cancel.store(true);
+            });
+        }
+    };
+    const int stops_before = sim.ReadRegister(kSimStopCountRegister);
+    const auto start = std::chrono::steady_clock::now();
+    auto session = CaptureSession(*table, camera, QuickCapture(2), CaptureStation{}, cb);
+    const auto took = std::chrono::steady_clock::now() - start;
+    canceller.join();
+
+    ASSERT_FALSE(session.ok());
+    EXPECT_EQ(session.error().code, "CANCELLED");
+    EXPECT_NE(session.error().message.find("pose 2 of 2"), std::string::npos)
+        << session.error().message;
+    EXPECT_LT(took, std::chrono::seconds(4));  // did not wait for the 6 s move
+    EXPECT_GT(sim.ReadRegister(kSimStopCountRegister), stops_before);
+    auto state = table->State();
+    ASSERT_TRUE(state.ok()) << state.error().message;
+    EXPECT_FALSE(state->moving);
+    EXPECT_LT(state->angle_deg, 170.0);
+}
+
+TEST(CaptureLoop, FaultingTurntableGivesTurntableError) {
+    TurntableSimulatorConfig sc = FastSimulator();
+    sc.fault = SimulatedFault::kStall;
+    sc.fault_after_moves = 1;  // the first pose move succeeds, a later one stalls
+    SimulatorThread sim(sc);
+    auto table = Connect(sim.port());
+    ASSERT_TRUE(table);
+    SimulatedCamera camera(SmallCamera(), AngleOf(*table));
+    ASSERT_TRUE(camera.Open().ok());
+
+    auto session = CaptureSession(*table, camera, QuickCapture(4), CaptureStation{});
+    ASSERT_FALSE(session.ok());
+    EXPECT_EQ(session.error().code, "TURNTABLE_ERROR");
+    EXPECT_NE(session.error().message.find("pose"), std::string::npos) << session.error().message;
+    auto state = table->State();
+    ASSERT_TRUE(state.ok());
+    EXPECT_FALSE(state->moving);
+}
+
+TEST(CaptureLoop, CameraErrorGivesCameraErrorAndStopsTheTable) {
+    SimulatorThread sim(FastSimulator());
+    auto table = Connect(sim.port());
+    ASSERT_TRUE(table);
+    SimulatedCameraConfig slow = SmallCamera();
+    slow.frame_interval_ms = 200;  // slower than the grab timeout below
+    SimulatedCamera camera(slow, AngleOf(*table));
+    ASSERT_TRUE(camera.Open().ok());
+
+    CaptureConfig capture = QuickCapture(3);
+    capture.grab_timeout_ms = 50;
+    const int stops_before = sim.ReadRegister(kSimStopCountRegister);
+    auto session = CaptureSession(*table, camera, capture, CaptureStation{});
+    ASSERT_FALSE(session.ok());
+    EXPECT_EQ(session.error().code, "CAMERA_ERROR");
+    EXPECT_NE(session.error().message.find("no depth frame within 50 ms"), std::string::npos)
+        << session.error().message;
+    EXPECT_GT(sim.ReadRegister(kSimStopCountRegister), stops_before);
+}
+
+TEST(CaptureLoop, CameraThatLostTheTableGivesCameraError) {
+    SimulatorThread sim(FastSimulator());
+    auto table = Connect(sim.port());
+    ASSERT_TRUE(table);
+    // The camera's angle source fails like a turntable link that went away.
+    SimulatedCamera camera(SmallCamera(), [] {
+        return Result<double>(Error{"TURNTABLE_ERROR", "link down"});
+    });
+    ASSERT_TRUE(camera.Open().ok());
+    auto session = CaptureSession(*table, camera, QuickCapture(2), CaptureStation{});
+    ASSERT_FALSE(session.ok());
+    EXPECT_EQ(session.error().code, "CAMERA_ERROR");
+    EXPECT_NE(session.error().message.find("link down"), std::string::npos);
+}
+
+TEST(CaptureConfig, ValidateNamesTheField) {
+    CaptureConfig c;
+    c.frames_per_pose = 0;
+    auto st = c.Validate();
+    ASSERT_FALSE(st.ok());
+    EXPECT_NE(st.error().message.find("capture.frames_per_pose"), std::string::npos);
+    c = CaptureConfig{};
+    c.angles_deg = {0.0, std::nan("")};
+    st = c.Validate();
+    ASSERT_FALSE(st.ok());
+    EXPECT_NE(st.error().message.find("capture.angles_deg[1]"), std::string::npos);
+    c = CaptureConfig{};
+    c.poses = 4;
+    EXPECT_EQ(c.Angles(), (std::vector<double>{0.0, 90.0, 180.0, 270.0}));
+}
+
+TEST(SimulatedCamera, AngleErrorIsPerPoseAndRepeatable) {
+    SimulatedCameraConfig c = SmallCamera();
+    c.station.angle_error_deg = 0.3;
+    SimulatedCamera camera(c, [] { return Result<double>(0.0); });
+    const double a = camera.TrueAngleRad(40.0);
+    EXPECT_DOUBLE_EQ(a, camera.TrueAngleRad(40.0));
+    EXPECT_NE(a, camera.TrueAngleRad(60.0) - (20.0 * M_PI / 180.0));
+    EXPECT_NEAR(a, 40.0 * M_PI / 180.0, 1.5 * M_PI / 180.0);  // 5 sigma
+    c.station.angle_error_deg = 0.0;
+    SimulatedCamera exact(c, [] { return Result<double>(0.0); });
+    EXPECT_DOUBLE_EQ(exact.TrueAngleRad(40.0), 40.0 * M_PI / 180.0);
+}
+
+}  // namespace
+}  // namespace boxd
