@@ -32,6 +32,15 @@ int HttpStatusOf(const std::string& code) {
     if (code == kBusyCode) return 409;
     if (code == "NOT_FOUND") return 404;
     if (code == kShuttingDownCode) return 503;
+    if (code == "NOT_IMPLEMENTED") return 501;
+    // The session could not calibrate the station (wrong or moved reference, table not seen):
+    // the request was understood but its reference box cannot serve.
+    // The calibration refusal codes (calibration/station_calibrator.h), kept as strings so the
+    // API does not depend on the estimator.
+    for (const char* refusal : {"TOO_FEW_POSES", "TABLE_NOT_VISIBLE", "NO_REFERENCE",
+                                "WRONG_REFERENCE", "BOX_MOVED", "NOT_CONVERGED"}) {
+        if (code == refusal) return 422;
+    }
     return 500;
 }
 
@@ -311,14 +320,18 @@ void HttpApi::Register(httplib::Server& server) {
                                  "reference_m must be [L, W, H] in metres, each in (0, 5)");
                         return;
                     }
-                    if (service_.Busy()) {
-                        SetError(res, 409, kBusyCode, "a measurement is running");
-                        return;
+                    const BoxDimensions reference{ref[0].get<double>(), ref[1].get<double>(),
+                                                  ref[2].get<double>()};
+                    Result<json> report =
+                        service_.Calibrate(reference, std::chrono::seconds(config_.wait_timeout_s));
+                    if (report) {
+                        SetJson(res, 200, *report);
+                    } else if (report.error().code == kTimeoutCode) {
+                        SetJson(res, 202, json{{"state", "calibrating"}});  // poll /v1/status
+                    } else {
+                        SetError(res, HttpStatusOf(report.error().code), report.error().code,
+                                 report.error().message);
                     }
-                    // boxd has no calibration estimator to run yet; say so instead of
-                    // pretending to calibrate.
-                    SetError(res, 501, "NOT_IMPLEMENTED",
-                             "station calibration is not available in this build of boxd");
                 }));
 
     server.Get("/v1/calibration", Guarded([this](const Request&, Response& res) {

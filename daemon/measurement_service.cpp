@@ -112,21 +112,25 @@ Status MeasurementService::ReplaceStation(std::shared_ptr<Station> station, bool
     return OkStatus();
 }
 
-Result<std::string> MeasurementService::Start() {
-    std::thread previous;
-    {
-        std::lock_guard lock(mutex_);
-        if (shutting_down_) return Error{kShuttingDownCode, "the daemon is stopping"};
-        if (running_) {
-            return Error{kBusyCode, "measurement " + current_id_ + " is running"};
-        }
-        running_ = true;
-        cancel_ = false;
-        current_id_.clear();
-        progress_ = JobProgress{"starting", 0, 0};
-        previous = std::move(worker_);
+Result<std::thread> MeasurementService::Claim(bool calibrating) {
+    std::lock_guard lock(mutex_);
+    if (shutting_down_) return Error{kShuttingDownCode, "the daemon is stopping"};
+    if (running_) {
+        return Error{kBusyCode, calibrating_ ? std::string("a calibration is running")
+                                             : "measurement " + current_id_ + " is running"};
     }
-    if (previous.joinable()) previous.join();  // it has finished; only the thread is left
+    running_ = true;
+    calibrating_ = calibrating;
+    cancel_ = false;
+    current_id_.clear();
+    progress_ = JobProgress{"starting", 0, 0};
+    return std::move(worker_);
+}
+
+Result<std::string> MeasurementService::Start() {
+    Result<std::thread> previous = Claim(false);
+    if (!previous) return previous.error();
+    if (previous->joinable()) previous->join();  // it has finished; only the thread is left
 
     auto fail = [this](const Error& e) -> Result<std::string> {
         {
@@ -231,6 +235,80 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
     Notify();
 }
 
+struct MeasurementService::CalibrationRun {
+    BoxDimensions reference;
+    bool done = false;  // guarded by mutex_
+    Result<json> result = Error{kInternalErrorCode, "not run"};
+};
+
+Result<json> MeasurementService::Calibrate(const BoxDimensions& reference,
+                                           std::chrono::milliseconds timeout) {
+    Result<std::thread> previous = Claim(true);
+    if (!previous) return previous.error();
+    if (previous->joinable()) previous->join();
+    auto run = std::make_shared<CalibrationRun>();
+    run->reference = reference;
+    {
+        std::lock_guard lock(mutex_);
+        worker_ = std::thread(&MeasurementService::RunCalibration, this, run, station_);
+    }
+    spdlog::info("calibration started, reference {:.4f} x {:.4f} x {:.4f} m", reference.length_m,
+                 reference.width_m, reference.height_m);
+    Notify();
+    std::unique_lock lock(mutex_);
+    if (!finished_cv_.wait_for(lock, timeout, [&] { return run->done; })) {
+        return Error{kTimeoutCode, "the calibration is still running"};
+    }
+    return run->result;
+}
+
+void MeasurementService::RunCalibration(std::shared_ptr<CalibrationRun> run,
+                                        std::shared_ptr<Station> station) {
+    JobContext ctx;
+    ctx.id = "calibration";
+    ctx.cancel = &cancel_;
+    ctx.progress = [this](const JobProgress& p) {
+        {
+            std::lock_guard lock(mutex_);
+            progress_ = p;
+        }
+        Notify();
+    };
+    Result<json> result = Error{kInternalErrorCode, "not run"};
+    try {
+        Status opened = station->IsOpen() ? OkStatus() : station->Open();
+        result = opened ? station->Calibrate(ctx, run->reference) : Result<json>(opened.error());
+    } catch (const std::exception& e) {
+        spdlog::critical("calibration: internal failure: {}", e.what());
+        station->RequestStop();
+        result = Error{kInternalErrorCode, e.what()};
+    }
+    if (!result && cancel_) {
+        result = Error{kAbortedCode, "calibration aborted: the daemon is stopping"};
+    }
+    if (result) {
+        spdlog::info("calibration done: the new calibration is in force");
+    } else {
+        spdlog::error("calibration failed: {}: {}", result.error().code, result.error().message);
+    }
+    const bool station_ok = station->IsOpen();
+    {
+        std::lock_guard lock(mutex_);
+        running_ = false;
+        calibrating_ = false;
+        progress_ = JobProgress{};
+        station_ok_ = station_ok;
+        if (!result) {
+            last_error_ = result.error();
+            last_error_at_ = UtcTimestampNow();
+        }
+        run->result = std::move(result);
+        run->done = true;
+    }
+    finished_cv_.notify_all();
+    Notify();
+}
+
 Result<json> MeasurementService::WaitFor(const std::string& id, std::chrono::milliseconds timeout) {
     {
         std::unique_lock lock(mutex_);
@@ -274,7 +352,7 @@ bool MeasurementService::Busy() const {
 ServiceSnapshot MeasurementService::Snapshot() const {
     std::lock_guard lock(mutex_);
     ServiceSnapshot s;
-    s.state = running_ ? ServiceState::kMeasuring
+    s.state = running_ ? (calibrating_ ? ServiceState::kCalibrating : ServiceState::kMeasuring)
                        : (station_ok_ ? ServiceState::kIdle : ServiceState::kError);
     s.measurement_id = current_id_;
     s.progress = progress_;

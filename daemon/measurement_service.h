@@ -61,6 +61,12 @@ public:
     // TIMEOUT after `timeout`, SHUTTING_DOWN if the run was abandoned.
     Result<nlohmann::json> WaitFor(const std::string& id, std::chrono::milliseconds timeout);
 
+    // Runs a station calibration with a reference box of size `reference` and returns its
+    // report once done; BUSY while a measurement or calibration runs, TIMEOUT after `timeout`
+    // (the calibration goes on), SHUTTING_DOWN after Abort(), or the station's error.
+    Result<nlohmann::json> Calibrate(const BoxDimensions& reference,
+                                     std::chrono::milliseconds timeout);
+
     // Stops the running measurement (the table is stopped at once) and refuses new ones.
     void Abort();
     // Waits until no measurement runs.
@@ -80,6 +86,10 @@ public:
 private:
     void Run(std::string id, std::filesystem::path scratch, std::shared_ptr<Station> station);
     JobOutput RunStation(Station& station, const JobContext& ctx);
+    struct CalibrationRun;
+    void RunCalibration(std::shared_ptr<CalibrationRun> run, std::shared_ptr<Station> station);
+    // Claims the worker for a new run; returns the previous (finished) worker thread to join.
+    Result<std::thread> Claim(bool calibrating);
     void Notify();
 
     MeasurementStore& store_;
@@ -89,6 +99,7 @@ private:
     bool keep_sessions_ = false;
     bool station_ok_ = false;
     bool running_ = false;
+    bool calibrating_ = false;
     bool shutting_down_ = false;
     std::atomic<bool> cancel_{false};
     std::string current_id_;

@@ -12,6 +12,7 @@
 #include "daemon/measurement_store.h"
 #include "pipeline/measurement.h"
 #include "pipeline/result.h"
+#include "pipeline/session.h"
 
 namespace boxd {
 
@@ -51,6 +52,12 @@ public:
     // Captures and measures one parcel. Never throws for expected failures: they come back as a
     // result with status no_dim/failed and a reason. Returns soon after ctx.cancel is set.
     virtual JobOutput Measure(const JobContext& ctx) = 0;
+    // Captures a session of a reference box of size `reference` (any order of length and
+    // width), estimates the station calibration from it and puts it in force for the following
+    // measurements. Returns the calibration report JSON, or the device / calibration error.
+    // Returns soon after ctx.cancel is set.
+    virtual Result<nlohmann::json> Calibrate(const JobContext& ctx,
+                                             const BoxDimensions& reference) = 0;
     // Stops the turntable now. Any thread; does not wait for the run to return.
     virtual void RequestStop() = 0;
     // Brings the devices to rest before the process exits (table stopped, connections closed).

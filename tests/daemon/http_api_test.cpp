@@ -57,6 +57,15 @@ public:
         out.files.cloud_ply = ply;
         return out;
     }
+    Result<json> Calibrate(const JobContext& ctx, const BoxDimensions& reference) override {
+        ctx.progress(JobProgress{"capture", 2, 4});
+        in_capture = true;
+        while (hold && !ctx.cancelled()) std::this_thread::sleep_for(2ms);
+        in_capture = false;
+        if (ctx.cancelled()) return Error{"CANCELLED", "capture cancelled"};
+        if (reference.height_m > 1.0) return Error{"WRONG_REFERENCE", "measured 0.2 m high"};
+        return json{{"calibration", {{"depth_scale", 1.0}}}, {"reference_h", reference.height_m}};
+    }
     void RequestStop() override { ++stop_requests; }
     void Shutdown() override { open_ = false; }
     json Devices() const override { return json{{"turntable", {{"ok", open_.load()}}}}; }
@@ -247,14 +256,42 @@ TEST_F(HttpApiTest, BadRequestsGetTheirCodesAndTheDaemonKeepsServing) {
     EXPECT_EQ(ok->status, 200);
 }
 
-TEST_F(HttpApiTest, CalibrateWithAValidBodyAnswersNotImplemented) {
+TEST_F(HttpApiTest, CalibrateRunsTheStationCalibrationAndReportsRefusals) {
+    auto done =
+        client_->Post("/v1/calibrate", R"({"reference_m": [0.4, 0.3, 0.2]})", "application/json");
+    ASSERT_TRUE(done);
+    ASSERT_EQ(done->status, 200) << done->body;
+    EXPECT_DOUBLE_EQ(Body(done)["reference_h"].get<double>(), 0.2);
     ExpectError(
-        client_->Post("/v1/calibrate", R"({"reference_m": [0.4, 0.3, 0.2]})", "application/json"),
-        501, "NOT_IMPLEMENTED");
+        client_->Post("/v1/calibrate", R"({"reference_m": [0.4, 0.3, 1.5]})", "application/json"),
+        422, "WRONG_REFERENCE");
+    EXPECT_EQ(Body(client_->Get("/v1/status"))["last_error"]["code"], "WRONG_REFERENCE");
     auto calibration = client_->Get("/v1/calibration");
     ASSERT_TRUE(calibration);
     EXPECT_EQ(calibration->status, 200);
     EXPECT_EQ(Body(calibration)["calibrated"], true);
+}
+
+TEST_F(HttpApiTest, WhileCalibratingTheStateSaysSoAndMeasurementsAreRefused) {
+    station_->hold = true;
+    std::thread calibrate([this] {
+        httplib::Client c("127.0.0.1", api_->tcp_port());
+        c.set_read_timeout(20, 0);
+        auto res =
+            c.Post("/v1/calibrate", R"({"reference_m": [0.4, 0.3, 0.2]})", "application/json");
+        EXPECT_TRUE(res && res->status == 200);
+    });
+    for (int i = 0; i < 1000 && !station_->in_capture; ++i) std::this_thread::sleep_for(2ms);
+    const json s = Body(client_->Get("/v1/status"));
+    EXPECT_EQ(s["state"], "calibrating");
+    EXPECT_EQ(s["progress"]["pose"], 2);
+    ExpectError(client_->Post("/v1/measure", "", "application/json"), 409, "BUSY");
+    ExpectError(
+        client_->Post("/v1/calibrate", R"({"reference_m": [0.4, 0.3, 0.2]})", "application/json"),
+        409, "BUSY");
+    station_->hold = false;
+    calibrate.join();
+    EXPECT_EQ(Body(client_->Get("/v1/status"))["state"], "idle");
 }
 
 TEST_F(HttpApiTest, DeviceFailureIsStoredAndShownAsErrorState) {
