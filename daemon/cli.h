@@ -26,6 +26,7 @@ void AddRecord(CLI::App& app, Runner& run);
 void AddSynth(CLI::App& app, Runner& run);
 void AddSimTurntable(CLI::App& app, Runner& run);
 void AddDevices(CLI::App& app, Runner& run);
+void AddBenchMeasure(CLI::App& app, Runner& run);
 
 // Prints "boxd: error: <message>" as one line on stderr and returns kExitBadInput.
 int FailBadInput(const std::string& message);

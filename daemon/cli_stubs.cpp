@@ -24,9 +24,6 @@ void AddStub(CLI::App& app, Runner& run, const char* name, const char* descripti
 void AddServe(CLI::App& app, Runner& run) {
     AddStub(app, run, "serve", "Run the daemon (REST/JSON API)");
 }
-void AddMeasure(CLI::App& app, Runner& run) {
-    AddStub(app, run, "measure", "Measure a recorded session offline");
-}
 void AddCalibrate(CLI::App& app, Runner& run) {
     AddStub(app, run, "calibrate", "Estimate the station calibration from a reference box");
 }

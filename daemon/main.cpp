@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
     AddSynth(app, run);
     AddSimTurntable(app, run);
     AddDevices(app, run);
+    AddBenchMeasure(app, run);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {

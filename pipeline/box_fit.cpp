@@ -1,0 +1,339 @@
+#include "pipeline/box_fit.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <unordered_map>
+#include <vector>
+
+namespace boxd {
+
+namespace {
+
+Status Bad(const std::string& field, const std::string& why) {
+    return Error{"INVALID_CONFIG", "box_fit." + field + ": " + why};
+}
+
+double Median(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    auto mid = v.begin() + static_cast<long>(v.size() / 2);
+    std::nth_element(v.begin(), mid, v.end());
+    return *mid;
+}
+
+// 1.4826 * MAD: the standard deviation of normally distributed residuals.
+double RobustSigma(const std::vector<double>& residuals) {
+    std::vector<double> a(residuals.size());
+    const double m = Median(residuals);
+    for (std::size_t i = 0; i < a.size(); ++i) a[i] = std::abs(residuals[i] - m);
+    return 1.4826 * Median(std::move(a));
+}
+
+// The box in its own footprint frame: u along `yaw`, v perpendicular, origin at the table.
+struct BoxState {
+    double yaw = 0.0;
+    // Outward offsets of the side faces along +u, -u, +v, -v: face f is {p : n_f · p = d_f}.
+    std::array<double, 4> d{};
+    double height = 0.0;
+    std::array<double, 5> sigma{};  // robust sigma per face (sides, top)
+};
+
+Eigen::Vector2d FaceNormal(double yaw, int face) {
+    const double a = yaw + (face == 0 ? 0.0 : face == 1 ? M_PI : face == 2 ? M_PI / 2 : -M_PI / 2);
+    return {std::cos(a), std::sin(a)};
+}
+
+// Returns the footprint seed: the minimal-area rectangle of the occupied footprint cells.
+Result<BoxState> SeedFootprint(const Points& points, const BoxFitConfig& config) {
+    const double inv = 1.0 / config.footprint_cell_m;
+    std::unordered_map<std::int64_t, int> cells;
+    for (const Eigen::Vector3f& p : points) {
+        if (p.z() < config.footprint_min_z_m) continue;
+        const auto ix = static_cast<std::int64_t>(std::floor(p.x() * inv));
+        const auto iy = static_cast<std::int64_t>(std::floor(p.y() * inv));
+        ++cells[(ix << 32) ^ (iy & 0xFFFFFFFF)];
+    }
+    std::vector<cv::Point2f> centres;
+    for (const auto& [key, count] : cells) {
+        if (count < config.footprint_min_cell_points) continue;
+        const auto ix = static_cast<double>(key >> 32);
+        const auto iy = static_cast<double>(static_cast<std::int32_t>(key & 0xFFFFFFFF));
+        centres.emplace_back(static_cast<float>((ix + 0.5) * config.footprint_cell_m),
+                             static_cast<float>((iy + 0.5) * config.footprint_cell_m));
+    }
+    if (centres.size() < 3) {
+        return Error{"OBJECT_TOO_SMALL", "the object's footprint is too small to measure"};
+    }
+    // Order-independent input for minAreaRect: sort the centres (the hash map order is not).
+    std::sort(centres.begin(), centres.end(), [](const cv::Point2f& a, const cv::Point2f& b) {
+        return a.x < b.x || (a.x == b.x && a.y < b.y);
+    });
+    std::vector<cv::Point2f> hull;
+    cv::convexHull(centres, hull);
+    const cv::RotatedRect rect = cv::minAreaRect(hull);
+    cv::Point2f corners[4];
+    rect.points(corners);
+    const Eigen::Vector2d c0(corners[0].x, corners[0].y), c1(corners[1].x, corners[1].y),
+        c2(corners[2].x, corners[2].y);
+    const Eigen::Vector2d e_u = c1 - c0, e_v = c2 - c1;
+    BoxState s;
+    s.yaw = std::atan2(e_u.y(), e_u.x());
+    const Eigen::Vector2d center(rect.center.x, rect.center.y);
+    const double half_u = 0.5 * e_u.norm(), half_v = 0.5 * e_v.norm();
+    for (int f = 0; f < 4; ++f) {
+        s.d[static_cast<std::size_t>(f)] =
+            FaceNormal(s.yaw, f).dot(center) + (f < 2 ? half_u : half_v);
+    }
+    return s;
+}
+
+struct FacePoint {
+    int face;
+    Eigen::Vector2d xy;
+};
+
+// One pass of the side-face fit: selects the points in each face's band (away from the edges),
+// then solves the linearised least squares for a common yaw and the four offsets, trimming
+// outliers once. Returns false when a face has too few points.
+bool FitSides(const Points& points, const BoxFitConfig& config, const std::array<double, 4>& band,
+              BoxState& s, std::array<int, 5>& counts) {
+    std::array<Eigen::Vector2d, 4> n;
+    for (int f = 0; f < 4; ++f) n[static_cast<std::size_t>(f)] = FaceNormal(s.yaw, f);
+    const double half_u = 0.5 * (s.d[0] + s.d[1]), half_v = 0.5 * (s.d[2] + s.d[3]);
+    const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);
+    const double m = config.edge_margin_m;
+    const double zlo = m, zhi = s.height - m;
+    std::vector<FacePoint> sel;
+    for (const Eigen::Vector3f& p3 : points) {
+        if (p3.z() < zlo || p3.z() > zhi) continue;
+        const Eigen::Vector2d p = p3.head<2>().cast<double>();
+        const double u = n[0].dot(p) - cu, v = n[2].dot(p) - cv;
+        for (int f = 0; f < 4; ++f) {
+            const auto k = static_cast<std::size_t>(f);
+            const double r = n[k].dot(p) - s.d[k];
+            if (std::abs(r) > band[k]) continue;
+            const double along = f < 2 ? v : u;
+            const double half = f < 2 ? half_v : half_u;
+            if (std::abs(along) > half - m) continue;
+            sel.push_back({f, p});
+        }
+    }
+    auto solve = [&](const std::vector<char>& use, std::array<int, 5>& cnt) {
+        // Unknowns: dyaw, dd0..dd3. r + (n'·p) dyaw - dd_f = 0.
+        Eigen::Matrix<double, 5, 5> h = Eigen::Matrix<double, 5, 5>::Zero();
+        Eigen::Matrix<double, 5, 1> g = Eigen::Matrix<double, 5, 1>::Zero();
+        cnt.fill(0);
+        for (std::size_t i = 0; i < sel.size(); ++i) {
+            if (!use[i]) continue;
+            const auto k = static_cast<std::size_t>(sel[i].face);
+            const Eigen::Vector2d nd(-n[k].y(), n[k].x());
+            const double r = n[k].dot(sel[i].xy) - s.d[k];
+            Eigen::Matrix<double, 5, 1> j = Eigen::Matrix<double, 5, 1>::Zero();
+            j(0) = nd.dot(sel[i].xy);
+            j(1 + static_cast<long>(k)) = -1.0;
+            h += j * j.transpose();
+            g += j * r;
+            ++cnt[k];
+        }
+        h.diagonal().array() += 1e-12;
+        return Eigen::Matrix<double, 5, 1>(h.ldlt().solve(-g));
+    };
+    std::vector<char> use(sel.size(), 1);
+    std::array<int, 5> cnt{};
+    Eigen::Matrix<double, 5, 1> delta = solve(use, cnt);
+    // Trim per face with the robust sigma of the residuals after the first solve.
+    std::array<std::vector<double>, 4> res;
+    std::vector<double> r_all(sel.size());
+    for (std::size_t i = 0; i < sel.size(); ++i) {
+        const auto k = static_cast<std::size_t>(sel[i].face);
+        const Eigen::Vector2d nd(-n[k].y(), n[k].x());
+        r_all[i] = n[k].dot(sel[i].xy) - s.d[k] + nd.dot(sel[i].xy) * delta(0) - delta(1 + k);
+        res[k].push_back(r_all[i]);
+    }
+    std::array<double, 4> sig{};
+    for (std::size_t k = 0; k < 4; ++k) sig[k] = std::max(RobustSigma(res[k]), 1e-4);
+    for (std::size_t i = 0; i < sel.size(); ++i) {
+        const auto k = static_cast<std::size_t>(sel[i].face);
+        use[i] = std::abs(r_all[i]) <= config.trim_sigmas * sig[k];
+    }
+    delta = solve(use, cnt);
+    for (std::size_t k = 0; k < 4; ++k) {
+        counts[k] = cnt[k];
+        s.sigma[k] = sig[k];
+    }
+    if (*std::min_element(cnt.begin(), cnt.begin() + 4) < config.min_face_points) return false;
+    // The offsets are relative to the old yaw's normals; the normals rotate with the yaw, which
+    // is what the linearisation assumed, so the offsets apply as they are.
+    s.yaw += delta(0);
+    for (std::size_t k = 0; k < 4; ++k) s.d[k] += delta(1 + static_cast<long>(k));
+    return true;
+}
+
+// Top face: trimmed mean height of the points inside the footprint (away from its edges) and in
+// the band around the current height estimate.
+bool FitTop(const Points& points, const BoxFitConfig& config, double band, BoxState& s,
+            std::array<int, 5>& counts) {
+    const Eigen::Vector2d nu = FaceNormal(s.yaw, 0), nv = FaceNormal(s.yaw, 2);
+    const double half_u = 0.5 * (s.d[0] + s.d[1]), half_v = 0.5 * (s.d[2] + s.d[3]);
+    const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);
+    const double m = config.edge_margin_m;
+    std::vector<double> z;
+    for (const Eigen::Vector3f& p3 : points) {
+        if (std::abs(p3.z() - s.height) > band) continue;
+        const Eigen::Vector2d p = p3.head<2>().cast<double>();
+        if (std::abs(nu.dot(p) - cu) > half_u - m || std::abs(nv.dot(p) - cv) > half_v - m) {
+            continue;
+        }
+        z.push_back(p3.z());
+    }
+    if (static_cast<int>(z.size()) < config.min_face_points) {
+        counts[4] = static_cast<int>(z.size());
+        return false;
+    }
+    const double med = Median(z);
+    std::vector<double> r(z.size());
+    for (std::size_t i = 0; i < z.size(); ++i) r[i] = z[i] - med;
+    const double sig = std::max(RobustSigma(r), 1e-4);
+    double sum = 0.0;
+    int n = 0;
+    for (double v : z) {
+        if (std::abs(v - med) <= config.trim_sigmas * sig) {
+            sum += v;
+            ++n;
+        }
+    }
+    counts[4] = n;
+    if (n < config.min_face_points) return false;
+    s.height = sum / n;
+    s.sigma[4] = sig;
+    return true;
+}
+
+}  // namespace
+
+Status BoxFitConfig::Validate() const {
+    if (!(footprint_min_z_m >= 0.0)) return Bad("footprint_min_z_m", "must be >= 0");
+    if (!(footprint_cell_m > 0.0005 && footprint_cell_m < 0.05)) {
+        return Bad("footprint_cell_m", "must be in (0.0005, 0.05)");
+    }
+    if (footprint_min_cell_points < 1) return Bad("footprint_min_cell_points", "must be >= 1");
+    if (!(seed_top_quantile > 0.5 && seed_top_quantile <= 1.0)) {
+        return Bad("seed_top_quantile", "must be in (0.5, 1]");
+    }
+    if (!(initial_band_m > 0.0)) return Bad("initial_band_m", "must be > 0");
+    if (!(min_band_m > 0.0 && min_band_m <= initial_band_m)) {
+        return Bad("min_band_m", "must be in (0, initial_band_m]");
+    }
+    if (!(band_sigmas >= 1.0)) return Bad("band_sigmas", "must be >= 1");
+    if (!(edge_margin_m >= 0.0)) return Bad("edge_margin_m", "must be >= 0");
+    if (!(trim_sigmas >= 1.0)) return Bad("trim_sigmas", "must be >= 1");
+    if (iterations < 1 || iterations > 50) return Bad("iterations", "must be in 1..50");
+    if (min_face_points < 3) return Bad("min_face_points", "must be >= 3");
+    return OkStatus();
+}
+
+Result<BoxFit> FitFootprintBox(const Points& points, const BoxFitConfig& config) {
+    if (points.size() < 10) return Error{"OBJECT_TOO_SMALL", "too few object points"};
+    auto seeded = SeedFootprint(points, config);
+    if (!seeded) return seeded.error();
+    BoxState s = *seeded;
+    {
+        std::vector<float> z(points.size());
+        for (std::size_t i = 0; i < points.size(); ++i) z[i] = points[i].z();
+        const auto q =
+            static_cast<long>(config.seed_top_quantile * static_cast<double>(z.size() - 1));
+        std::nth_element(z.begin(), z.begin() + q, z.end());
+        s.height = z[static_cast<std::size_t>(q)];
+    }
+    const double min_side = std::min(s.d[0] + s.d[1], s.d[2] + s.d[3]);
+    if (min_side < 2.0 * config.edge_margin_m + 0.01 ||
+        s.height < 2.0 * config.edge_margin_m + 0.005) {
+        return Error{"OBJECT_TOO_SMALL", "the object is too small to measure"};
+    }
+    std::array<double, 4> band;
+    band.fill(config.initial_band_m);
+    double top_band = config.initial_band_m;
+    std::array<int, 5> counts{};
+    for (int it = 0; it < config.iterations; ++it) {
+        if (!FitTop(points, config, top_band, s, counts)) {
+            return Error{"INSUFFICIENT_DATA", "the top face is not observed well enough"};
+        }
+        if (!FitSides(points, config, band, s, counts)) {
+            return Error{"INSUFFICIENT_DATA",
+                         "a side face of the object is not observed well enough"};
+        }
+        for (std::size_t k = 0; k < 4; ++k) {
+            band[k] = std::clamp(config.band_sigmas * s.sigma[k], config.min_band_m,
+                                 config.initial_band_m);
+        }
+        top_band =
+            std::clamp(config.band_sigmas * s.sigma[4], config.min_band_m, config.initial_band_m);
+    }
+    if (!FitTop(points, config, top_band, s, counts)) {
+        return Error{"INSUFFICIENT_DATA", "the top face is not observed well enough"};
+    }
+    BoxFit fit;
+    const double len_u = s.d[0] + s.d[1], len_v = s.d[2] + s.d[3];
+    const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);
+    const Eigen::Vector2d nu = FaceNormal(s.yaw, 0), nv = FaceNormal(s.yaw, 2);
+    fit.center_m = cu * nu + cv * nv;
+    fit.length_m = std::max(len_u, len_v);
+    fit.width_m = std::min(len_u, len_v);
+    fit.length_axis = len_u >= len_v ? nu : nv;
+    fit.height_m = s.height;
+    fit.face_points = counts;
+    fit.face_sigma_m = *std::max_element(s.sigma.begin(), s.sigma.end());
+    return fit;
+}
+
+OrientedBox FitPcaBox(const Points& points) {
+    OrientedBox box;
+    if (points.empty()) return box;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (const auto& p : points) mean += p.head<2>().cast<double>();
+    mean /= static_cast<double>(points.size());
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+    for (const auto& p : points) {
+        const Eigen::Vector2d d = p.head<2>().cast<double>() - mean;
+        cov += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(cov);
+    Eigen::Vector2d e1 = es.eigenvectors().col(1);  // major axis
+    // A sign convention makes the axes deterministic: the major axis points to +x (or +y).
+    if (e1.x() < 0.0 || (e1.x() == 0.0 && e1.y() < 0.0)) e1 = -e1;
+    const Eigen::Vector2d e2(-e1.y(), e1.x());
+    double lo1 = 1e9, hi1 = -1e9, lo2 = 1e9, hi2 = -1e9, hz = 0.0;
+    for (const auto& p : points) {
+        const Eigen::Vector2d d = p.head<2>().cast<double>();
+        lo1 = std::min(lo1, e1.dot(d));
+        hi1 = std::max(hi1, e1.dot(d));
+        lo2 = std::min(lo2, e2.dot(d));
+        hi2 = std::max(hi2, e2.dot(d));
+        hz = std::max(hz, static_cast<double>(p.z()));
+    }
+    const Eigen::Vector2d c = 0.5 * (lo1 + hi1) * e1 + 0.5 * (lo2 + hi2) * e2;
+    box.extent_m = {hi1 - lo1, hi2 - lo2, hz};
+    box.volume_m3 = box.extent_m[0] * box.extent_m[1] * box.extent_m[2];
+    box.center_m = {c.x(), c.y(), 0.5 * hz};
+    box.axes = {{{e1.x(), e1.y(), 0.0}, {e2.x(), e2.y(), 0.0}, {0.0, 0.0, 1.0}}};
+    return box;
+}
+
+double DistanceToBoxSurface(const BoxFit& box, const Eigen::Vector3f& p) {
+    const Eigen::Vector2d a = box.length_axis, b(-a.y(), a.x());
+    const Eigen::Vector2d d = p.head<2>().cast<double>() - box.center_m;
+    // Coordinates relative to the box centre; the box spans [-hl, hl] x [-hw, hw] x [0, h].
+    const double u = a.dot(d), v = b.dot(d), z = p.z();
+    const double hl = 0.5 * box.length_m, hw = 0.5 * box.width_m, h = box.height_m;
+    const double ou = std::abs(u) - hl, ov = std::abs(v) - hw, oz = std::max(z - h, -z);
+    if (ou > 0.0 || ov > 0.0 || oz > 0.0) {
+        return std::sqrt(std::pow(std::max(ou, 0.0), 2) + std::pow(std::max(ov, 0.0), 2) +
+                         std::pow(std::max(oz, 0.0), 2));
+    }
+    // Inside: the nearest of the sides and the top (the bottom rests on the table, unseen).
+    return std::min({-ou, -ov, h - z});
+}
+
+}  // namespace boxd

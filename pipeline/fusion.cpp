@@ -1,0 +1,95 @@
+#include "pipeline/fusion.h"
+
+#include <algorithm>
+#include <cmath>
+#include <unordered_map>
+
+namespace boxd {
+
+namespace {
+
+std::uint64_t CellKey(const Eigen::Vector3f& p, float inv) {
+    auto q = [inv](float v) {
+        return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v * inv)) +
+                                          (1 << 20)) &
+               0x1FFFFF;
+    };
+    return (q(p.x()) << 42) | (q(p.y()) << 21) | q(p.z());
+}
+
+}  // namespace
+
+Status FusionConfig::Validate() const {
+    auto bad = [](const std::string& f, const std::string& why) -> Status {
+        return Error{"INVALID_CONFIG", "fusion." + f + ": " + why};
+    };
+    if (!(support_voxel_m > 0.0005 && support_voxel_m < 0.1)) {
+        return bad("support_voxel_m", "must be in (0.0005, 0.1)");
+    }
+    if (min_support_points < 1) return bad("min_support_points", "must be >= 1");
+    if (!(surface_tolerance_m > 0.0)) return bad("surface_tolerance_m", "must be > 0");
+    if (!(min_view_inlier_fraction >= 0.0 && min_view_inlier_fraction <= 1.0)) {
+        return bad("min_view_inlier_fraction", "must be in [0, 1]");
+    }
+    if (min_view_points < 1) return bad("min_view_points", "must be >= 1");
+    return OkStatus();
+}
+
+FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& poses,
+                     const FusionConfig& config) {
+    FusedCloud all;
+    std::size_t total = 0;
+    for (const Points& v : views) total += v.size();
+    all.points.reserve(total);
+    all.view.reserve(total);
+    for (std::size_t k = 0; k < views.size(); ++k) {
+        for (const Eigen::Vector3f& p : views[k]) {
+            all.points.push_back(poses[k].Apply(p));
+            all.view.push_back(static_cast<std::uint16_t>(k));
+        }
+    }
+    const float inv = static_cast<float>(1.0 / config.support_voxel_m);
+    std::vector<std::uint64_t> keys(all.points.size());
+    std::unordered_map<std::uint64_t, int> counts;
+    counts.reserve(all.points.size() / 4 + 16);
+    for (std::size_t i = 0; i < all.points.size(); ++i) {
+        keys[i] = CellKey(all.points[i], inv);
+        ++counts[keys[i]];
+    }
+    FusedCloud out;
+    out.points.reserve(all.points.size());
+    out.view.reserve(all.points.size());
+    for (std::size_t i = 0; i < all.points.size(); ++i) {
+        if (counts[keys[i]] < config.min_support_points) continue;
+        out.points.push_back(all.points[i]);
+        out.view.push_back(all.view[i]);
+    }
+    return out;
+}
+
+ConsistencyReport CheckViewConsistency(const FusedCloud& cloud, int num_views, const BoxFit& box,
+                                       const FusionConfig& config) {
+    ConsistencyReport report;
+    std::vector<int> total(static_cast<std::size_t>(num_views), 0);
+    std::vector<int> inliers(static_cast<std::size_t>(num_views), 0);
+    for (std::size_t i = 0; i < cloud.points.size(); ++i) {
+        const std::size_t v = cloud.view[i];
+        if (v >= total.size()) continue;
+        ++total[v];
+        if (DistanceToBoxSurface(box, cloud.points[i]) <= config.surface_tolerance_m) ++inliers[v];
+    }
+    for (int v = 0; v < num_views; ++v) {
+        const auto k = static_cast<std::size_t>(v);
+        if (total[k] < config.min_view_points) continue;
+        ++report.judged_views;
+        const double f = static_cast<double>(inliers[k]) / total[k];
+        if (f < report.worst_inlier_fraction) {
+            report.worst_inlier_fraction = f;
+            report.worst_view = v;
+        }
+        if (f < config.min_view_inlier_fraction) report.inconsistent_views.push_back(v);
+    }
+    return report;
+}
+
+}  // namespace boxd

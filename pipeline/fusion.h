@@ -1,0 +1,49 @@
+#pragma once
+// Stage 6: fusion of the registered views into one table-frame cloud, outlier removal, and the
+// view-consistency check.
+
+#include <cstdint>
+#include <vector>
+
+#include "pipeline/box_fit.h"
+#include "pipeline/point_cloud.h"
+#include "pipeline/result.h"
+#include "pipeline/se2.h"
+
+namespace boxd {
+
+struct FusionConfig {
+    // Points in voxels holding fewer than min_support_points (all views together) are outliers.
+    double support_voxel_m = 0.006;
+    int min_support_points = 3;
+    // View consistency: a view whose points lie within surface_tolerance_m of the fitted box in
+    // less than min_view_inlier_fraction of cases disagrees with the others.
+    double surface_tolerance_m = 0.01;
+    double min_view_inlier_fraction = 0.7;
+    int min_view_points = 300;  // views with fewer object points are not judged
+
+    // Returns an error naming the first invalid field, or Ok.
+    Status Validate() const;
+};
+
+struct FusedCloud {
+    Points points;                    // table frame of pose 0
+    std::vector<std::uint16_t> view;  // source view of each point
+};
+
+struct ConsistencyReport {
+    int judged_views = 0;
+    int worst_view = -1;
+    double worst_inlier_fraction = 1.0;
+    std::vector<int> inconsistent_views;
+};
+
+// Returns the union of `views` moved by `poses`, without the points of sparsely supported voxels.
+FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& poses,
+                     const FusionConfig& config);
+
+// Returns, per view, whether its points agree with the fitted box.
+ConsistencyReport CheckViewConsistency(const FusedCloud& cloud, int num_views, const BoxFit& box,
+                                       const FusionConfig& config);
+
+}  // namespace boxd

@@ -1,0 +1,78 @@
+#pragma once
+// Stage 4: point-to-plane ICP restricted to SE(2) in the table frame (x, y, yaw). Coarse and fine
+// registration are this one function with two configs.
+
+#include <Eigen/Core>
+#include <memory>
+
+#include "pipeline/point_cloud.h"
+#include "pipeline/result.h"
+#include "pipeline/se2.h"
+
+namespace boxd {
+
+struct IcpConfig {
+    double max_correspondence_m = 0.01;  // pairs farther apart than this are ignored
+    int max_iterations = 30;
+    double translation_tolerance_m = 2e-5;  // converged when a step is smaller than both
+    double yaw_tolerance_rad = 2e-5;
+    // Target normals steeper than this |n_z| belong to horizontal surfaces, which say nothing
+    // about (x, y, yaw); they count for fitness and RMSE but not in the solve.
+    double max_solve_normal_z = 0.7;
+    int min_correspondences = 30;
+    // Pairs whose normals disagree by more than acos(min_normal_dot) are not the same surface
+    // (box corners); Geman-McClure weights with this scale damp the remaining outliers.
+    double min_normal_dot = 0.9;
+    double robust_scale_m = 0.004;
+    // Weight of an in-plane point-to-point term beside point-to-plane. Where the data leave a
+    // direction free (one face seen face-on), the outlines of the faces still fix it.
+    double point_to_point_weight = 0.3;
+    double sigma_floor_m = 0.0005;  // lower bound of the residual sigma in the information
+    // A weak prior toward `init` (the turntable model) keeps directions the data leave free
+    // (sliding along a single visible face) where they started instead of letting them drift.
+    // It acts like one correspondence with these sigmas; the reported information excludes it.
+    double prior_translation_sigma_m = 0.01;
+    double prior_yaw_sigma_rad = 0.035;
+
+    // Returns an error naming the first invalid field (prefixed with `where`), or Ok.
+    Status Validate(const std::string& where) const;
+};
+
+struct IcpResult {
+    Se2 transform;         // maps source points onto the target
+    double fitness = 0.0;  // fraction of source points with a correspondence
+    double rmse = 0.0;     // point-to-plane RMSE of the correspondences, metres
+    // Information of the (x, y, yaw) left perturbation of `transform`: JᵀJ / sigma².
+    Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+    // JᵀJ / N: for a motion error e, sqrt(eᵀ S e) is the RMS displacement it causes along the
+    // target normals, i.e. how much a disagreement of e actually moves the surfaces.
+    Eigen::Matrix3d point_scatter = Eigen::Matrix3d::Zero();
+    bool converged = false;
+    int correspondences = 0;
+    int iterations = 0;
+};
+
+// A target cloud with its search index, built once and shared by every alignment onto it.
+class IcpTarget {
+public:
+    explicit IcpTarget(OrientedPoints cloud);
+    ~IcpTarget();
+    IcpTarget(IcpTarget&&) noexcept;
+    IcpTarget& operator=(IcpTarget&&) noexcept;
+
+    const OrientedPoints& cloud() const { return cloud_; }
+    // Returns the index of the nearest target point within `max_dist`, or -1.
+    int Nearest(const Eigen::Vector3f& p, float max_dist) const;
+
+private:
+    struct Index;
+    OrientedPoints cloud_;
+    std::unique_ptr<Index> index_;
+};
+
+// Returns the SE(2) motion that best aligns `source` onto `target`, starting from `init`, by
+// Gauss-Newton on point-to-plane residuals (Chen & Medioni 1992) with 3 parameters.
+IcpResult AlignIcp(const OrientedPoints& source, const IcpTarget& target, const Se2& init,
+                   const IcpConfig& config);
+
+}  // namespace boxd

@@ -1,0 +1,30 @@
+#pragma once
+// A minimal static parallel loop: index i runs on thread i % threads, results go to per-index
+// slots, so the outcome never depends on thread timing.
+
+#include <algorithm>
+#include <thread>
+#include <vector>
+
+namespace boxd {
+
+// Calls fn(i) for every i in [0, count) on up to `threads` threads; returns when all are done.
+template <typename Fn>
+void ParallelFor(int count, int threads, Fn&& fn) {
+    const int n = std::max(1, std::min(threads, count));
+    if (n == 1) {
+        for (int i = 0; i < count; ++i) fn(i);
+        return;
+    }
+    std::vector<std::thread> pool;
+    pool.reserve(static_cast<std::size_t>(n - 1));
+    for (int t = 1; t < n; ++t) {
+        pool.emplace_back([&fn, t, n, count] {
+            for (int i = t; i < count; i += n) fn(i);
+        });
+    }
+    for (int i = 0; i < count; i += n) fn(i);
+    for (std::thread& th : pool) th.join();
+}
+
+}  // namespace boxd

@@ -1,0 +1,225 @@
+#include "pipeline/pose_graph.h"
+
+#include <ceres/ceres.h>
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+namespace boxd {
+
+namespace {
+
+template <typename T>
+T NormalizeAngle(const T& a) {
+    const T two_pi(2.0 * M_PI);
+    return a - two_pi * ceres::floor((a + T(M_PI)) / two_pi);
+}
+
+// Residual of a relative measurement: the left perturbation taking the measured motion onto the
+// predicted one, pred = X_from⁻¹ ∘ X_to, weighted by the square-root information.
+class RelativeCost {
+public:
+    RelativeCost(const Se2& measured, const Eigen::Matrix3d& sqrt_information)
+        : m_(measured), sqrt_info_(sqrt_information) {}
+
+    template <typename T>
+    bool operator()(const T* a, const T* b, T* residual) const {
+        // pred = a⁻¹ ∘ b
+        const T ca = ceres::cos(a[2]), sa = ceres::sin(a[2]);
+        const T dx = b[0] - a[0], dy = b[1] - a[1];
+        const T px = ca * dx + sa * dy;
+        const T py = -sa * dx + ca * dy;
+        const T pyaw = b[2] - a[2];
+        // d = pred ∘ meas⁻¹: yaw = pyaw - myaw, t = t_pred - R(d_yaw) t_meas
+        const T dyaw = NormalizeAngle(pyaw - T(m_.yaw));
+        const T c = ceres::cos(dyaw), s = ceres::sin(dyaw);
+        Eigen::Matrix<T, 3, 1> e;
+        e(0) = px - (c * T(m_.x) - s * T(m_.y));
+        e(1) = py - (s * T(m_.x) + c * T(m_.y));
+        e(2) = dyaw;
+        Eigen::Map<Eigen::Matrix<T, 3, 1>> r(residual);
+        r = sqrt_info_.cast<T>() * e;
+        return true;
+    }
+
+    static ceres::CostFunction* Create(const Se2& measured, const Eigen::Matrix3d& sqrt_info) {
+        return new ceres::AutoDiffCostFunction<RelativeCost, 3, 3, 3>(
+            new RelativeCost(measured, sqrt_info));
+    }
+
+private:
+    Se2 m_;
+    Eigen::Matrix3d sqrt_info_;
+};
+
+// Turntable model prior: node k is a rotation by its commanded yaw about the common centre c,
+// pose = c - R(yaw) c. The translation part uses the node's own yaw so that the turntable's angle
+// error does not leak into the translation.
+class TurntablePriorCost {
+public:
+    TurntablePriorCost(double commanded_yaw, double yaw_sigma, double center_sigma)
+        : yaw_(commanded_yaw), inv_yaw_sigma_(1.0 / yaw_sigma), inv_t_sigma_(1.0 / center_sigma) {}
+
+    template <typename T>
+    bool operator()(const T* pose, const T* center, T* residual) const {
+        const T c = ceres::cos(pose[2]), s = ceres::sin(pose[2]);
+        const T mx = center[0] - (c * center[0] - s * center[1]);
+        const T my = center[1] - (s * center[0] + c * center[1]);
+        residual[0] = (pose[0] - mx) * T(inv_t_sigma_);
+        residual[1] = (pose[1] - my) * T(inv_t_sigma_);
+        residual[2] = NormalizeAngle(pose[2] - T(yaw_)) * T(inv_yaw_sigma_);
+        return true;
+    }
+
+    static ceres::CostFunction* Create(double yaw, double yaw_sigma, double center_sigma) {
+        return new ceres::AutoDiffCostFunction<TurntablePriorCost, 3, 3, 2>(
+            new TurntablePriorCost(yaw, yaw_sigma, center_sigma));
+    }
+
+private:
+    double yaw_, inv_yaw_sigma_, inv_t_sigma_;
+};
+
+Eigen::Matrix3d SqrtInformation(const Eigen::Matrix3d& information) {
+    // Upper Cholesky factor U with UᵀU = information, so |U e|² = eᵀ I e.
+    Eigen::Matrix3d info = 0.5 * (information + information.transpose());
+    info.diagonal().array() += 1e-9 * info.trace() + 1e-12;
+    Eigen::LLT<Eigen::Matrix3d> llt(info);
+    return llt.matrixU();
+}
+
+struct Problem {
+    std::vector<std::array<double, 3>> params;
+    std::array<double, 2> center{};
+    std::unique_ptr<ceres::Problem> problem;
+};
+
+void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Problem& p) {
+    p.params.resize(graph.poses.size());
+    for (std::size_t k = 0; k < graph.poses.size(); ++k) {
+        p.params[k] = {graph.poses[k].x, graph.poses[k].y, graph.poses[k].yaw};
+    }
+    p.center = {graph.center_offset.x(), graph.center_offset.y()};
+    p.problem = std::make_unique<ceres::Problem>();
+    for (const PoseEdge& e : graph.edges) {
+        if (e.rejected) continue;
+        ceres::LossFunction* loss =
+            e.loop_closure ? new ceres::HuberLoss(config.loop_huber_scale) : nullptr;
+        const Eigen::Matrix3d info =
+            e.point_scatter / (config.edge_displacement_sigma_m * config.edge_displacement_sigma_m);
+        p.problem->AddResidualBlock(RelativeCost::Create(e.measured, SqrtInformation(info)), loss,
+                                    p.params[static_cast<std::size_t>(e.from)].data(),
+                                    p.params[static_cast<std::size_t>(e.to)].data());
+    }
+    for (std::size_t k = 1; k < graph.poses.size(); ++k) {
+        p.problem->AddResidualBlock(
+            TurntablePriorCost::Create(graph.commanded_yaw[k], config.prior_yaw_sigma_rad,
+                                       config.prior_center_sigma_m),
+            nullptr, p.params[k].data(), p.center.data());
+    }
+    if (!graph.poses.empty()) {
+        p.problem->AddParameterBlock(p.params[0].data(), 3);
+        p.problem->SetParameterBlockConstant(p.params[0].data());
+    }
+}
+
+}  // namespace
+
+Status PoseGraphConfig::Validate() const {
+    auto bad = [](const std::string& f, const std::string& why) -> Status {
+        return Error{"INVALID_CONFIG", "pose_graph." + f + ": " + why};
+    };
+    if (!(prior_yaw_sigma_rad > 0.0)) return bad("prior_yaw_sigma_rad", "must be > 0");
+    if (!(prior_center_sigma_m > 0.0)) return bad("prior_center_sigma_m", "must be > 0");
+    if (!(edge_displacement_sigma_m > 0.0)) return bad("edge_displacement_sigma_m", "must be > 0");
+    if (!(loop_huber_scale > 0.0)) return bad("loop_huber_scale", "must be > 0");
+    if (!(max_edge_displacement_m > 0.0)) return bad("max_edge_displacement_m", "must be > 0");
+    if (max_rejection_rounds < 0) return bad("max_rejection_rounds", "must be >= 0");
+    if (max_solver_iterations < 1) return bad("max_solver_iterations", "must be >= 1");
+    return OkStatus();
+}
+
+Eigen::Vector3d EdgeResidual(const PoseGraph& graph, const PoseEdge& edge) {
+    const Se2& a = graph.poses[static_cast<std::size_t>(edge.from)];
+    const Se2& b = graph.poses[static_cast<std::size_t>(edge.to)];
+    return Se2Difference(a.Inverse().Compose(b), edge.measured);
+}
+
+double EdgeDisplacement(const PoseGraph& graph, const PoseEdge& edge) {
+    const Eigen::Vector3d r = EdgeResidual(graph, edge);
+    return std::sqrt(std::max(0.0, r.dot(edge.point_scatter * r)));
+}
+
+Status SolvePoseGraph(PoseGraph& graph, const PoseGraphConfig& config) {
+    if (graph.poses.size() < 2) return OkStatus();
+    Problem p;
+    BuildProblem(graph, config, p);
+    ceres::Solver::Options options;
+    options.linear_solver_type = ceres::DENSE_QR;
+    options.max_num_iterations = config.max_solver_iterations;
+    options.num_threads = 1;  // deterministic
+    options.logging_type = ceres::SILENT;
+    std::string why;
+    if (!options.IsValid(&why)) return Error{"INTERNAL", "pose graph solver options: " + why};
+    ceres::Solver::Summary summary;
+    ceres::Solve(options, p.problem.get(), &summary);
+    if (!summary.IsSolutionUsable()) {
+        return Error{"REGISTRATION_FAILED", "pose graph did not solve: " + summary.message};
+    }
+    for (std::size_t k = 0; k < graph.poses.size(); ++k) {
+        graph.poses[k] = Se2{p.params[k][0], p.params[k][1], Se2::WrapAngle(p.params[k][2])};
+    }
+    graph.center_offset = {p.center[0], p.center[1]};
+    return OkStatus();
+}
+
+Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfig& config) {
+    if (graph.commanded_yaw.size() != graph.poses.size()) {
+        return Error{"INTERNAL", "pose graph: commanded_yaw and poses differ in size"};
+    }
+    PoseGraphReport report;
+    for (int round = 0;; ++round) {
+        if (Status s = SolvePoseGraph(graph, config); !s) return s.error();
+        // The worst edge relative to the thresholds; ties broken by index (deterministic).
+        int worst = -1;
+        double worst_ratio = 1.0;
+        for (std::size_t i = 0; i < graph.edges.size(); ++i) {
+            if (graph.edges[i].rejected) continue;
+            const double ratio =
+                EdgeDisplacement(graph, graph.edges[i]) / config.max_edge_displacement_m;
+            if (ratio > worst_ratio) {
+                worst_ratio = ratio;
+                worst = static_cast<int>(i);
+            }
+        }
+        if (worst < 0 || round >= config.max_rejection_rounds) break;
+        graph.edges[static_cast<std::size_t>(worst)].rejected = true;
+        ++report.rejected_edges;
+    }
+    std::vector<int> degree(graph.poses.size(), 0);
+    for (const PoseEdge& e : graph.edges) {
+        if (e.rejected) continue;
+        ++report.active_edges;
+        ++degree[static_cast<std::size_t>(e.from)];
+        ++degree[static_cast<std::size_t>(e.to)];
+        report.max_edge_displacement_m =
+            std::max(report.max_edge_displacement_m, EdgeDisplacement(graph, e));
+    }
+    for (std::size_t k = 0; k < graph.poses.size(); ++k) {
+        if (graph.poses.size() > 1 && degree[k] == 0) ++report.unconstrained_nodes;
+        const Se2 model = Se2::RotationAbout(graph.commanded_yaw[k], graph.center_offset);
+        const Eigen::Vector3d d = Se2Difference(graph.poses[k], model);
+        report.max_model_yaw_deviation_rad =
+            std::max(report.max_model_yaw_deviation_rad, std::abs(d.z()));
+        // Translation deviation measured with the node's own yaw (as in the prior).
+        const Se2 own = Se2::RotationAbout(graph.poses[k].yaw, graph.center_offset);
+        report.max_model_translation_deviation_m =
+            std::max(report.max_model_translation_deviation_m,
+                     std::hypot(graph.poses[k].x - own.x, graph.poses[k].y - own.y));
+    }
+    return report;
+}
+
+}  // namespace boxd

@@ -1,0 +1,74 @@
+#pragma once
+// Stage 5: SE(2) pose-graph optimisation of the turntable views (Ceres), in the style of Ceres'
+// examples/slam: plain structs, one cost functor per constraint kind, build and solve separate.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "pipeline/result.h"
+#include "pipeline/se2.h"
+
+namespace boxd {
+
+struct PoseGraphConfig {
+    // Prior tying node k to the commanded turntable angle about a common (estimated) centre: it
+    // absorbs the in-plane centre error of the calibration and fills the directions the ICP edges
+    // leave free (a box face seen face-on lets a view slide along it).
+    double prior_yaw_sigma_rad = 0.5 * M_PI / 180.0;  // turntable angle error
+    double prior_center_sigma_m = 0.001;
+    // Edges are weighted by their surface displacement (IcpResult::point_scatter) over this
+    // sigma: ICP errors are correlated across points, so JᵀJ / sigma² would be overconfident.
+    double edge_displacement_sigma_m = 0.001;
+    double loop_huber_scale = 2.0;  // Huber loss on loop closures, in edge sigmas
+    // An edge whose solved residual moves its surfaces by more than this (RMS along the normals)
+    // is rejected and the graph re-solved. Directions the edge's data do not constrain (sliding
+    // along a face) do not count.
+    double max_edge_displacement_m = 0.002;
+    int max_rejection_rounds = 20;
+    int max_solver_iterations = 100;
+
+    // Returns an error naming the first invalid field, or Ok.
+    Status Validate() const;
+};
+
+// A relative measurement: `measured` maps view `to`'s points into view `from`'s frame.
+struct PoseEdge {
+    int from = 0;
+    int to = 0;
+    Se2 measured;
+    Eigen::Matrix3d information = Eigen::Matrix3d::Identity();    // (x, y, yaw) left perturbation
+    Eigen::Matrix3d point_scatter = Eigen::Matrix3d::Identity();  // per-point JᵀJ / N
+    bool loop_closure = false;
+    bool rejected = false;
+};
+
+// Node k's pose maps view k's points into the frame of view 0 (held constant).
+struct PoseGraph {
+    std::vector<Se2> poses;
+    std::vector<double> commanded_yaw;  // the turntable model's pose yaw (minus the table angle)
+    std::vector<PoseEdge> edges;
+    Eigen::Vector2d center_offset = Eigen::Vector2d::Zero();  // estimated axis offset
+};
+
+struct PoseGraphReport {
+    int rejected_edges = 0;
+    int active_edges = 0;
+    double max_edge_displacement_m = 0.0;      // largest residual among the kept edges
+    double max_model_yaw_deviation_rad = 0.0;  // registered poses vs the turntable model
+    double max_model_translation_deviation_m = 0.0;
+    int unconstrained_nodes = 0;  // nodes without any kept edge
+};
+
+// Solves `graph` once with the edges not marked rejected; updates poses and centre offset.
+Status SolvePoseGraph(PoseGraph& graph, const PoseGraphConfig& config);
+
+// Solves, rejects the worst disagreeing edge, and re-solves until every kept edge agrees.
+Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfig& config);
+
+// Returns the residual (x, y, yaw) of `edge` at the graph's current poses.
+Eigen::Vector3d EdgeResidual(const PoseGraph& graph, const PoseEdge& edge);
+
+// Returns the RMS surface displacement (metres) that `edge`'s residual causes.
+double EdgeDisplacement(const PoseGraph& graph, const PoseEdge& edge);
+
+}  // namespace boxd

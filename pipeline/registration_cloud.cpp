@@ -1,0 +1,112 @@
+#include "pipeline/registration_cloud.h"
+
+#include <pcl/features/normal_3d.h>
+#include <pcl/filters/statistical_outlier_removal.h>
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+#include <pcl/search/kdtree.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+namespace boxd {
+
+namespace {
+
+// 21 bits per axis: +-1e6 voxels, far more than any measuring volume needs.
+std::uint64_t VoxelKey(const Eigen::Vector3f& p, float inv) {
+    auto q = [inv](float v) {
+        return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v * inv)) +
+                                          (1 << 20)) &
+               0x1FFFFF;
+    };
+    return (q(p.x()) << 42) | (q(p.y()) << 21) | q(p.z());
+}
+
+}  // namespace
+
+Status RegistrationCloudConfig::Validate(const std::string& where) const {
+    auto bad = [&](const std::string& f, const std::string& why) -> Status {
+        return Error{"INVALID_CONFIG", where + "." + f + ": " + why};
+    };
+    if (!(voxel_m > 0.0005 && voxel_m < 0.1)) return bad("voxel_m", "must be in (0.0005, 0.1)");
+    if (outlier_neighbors < 0 || outlier_neighbors > 100) {
+        return bad("outlier_neighbors", "must be in 0..100 (0 disables)");
+    }
+    if (!(outlier_std_ratio > 0.0)) return bad("outlier_std_ratio", "must be > 0");
+    if (normal_neighbors < 3 || normal_neighbors > 100) {
+        return bad("normal_neighbors", "must be in 3..100");
+    }
+    if (max_points < 100) return bad("max_points", "must be >= 100");
+    if (!(max_surface_variation > 0.0 && max_surface_variation <= 1.0 / 3.0)) {
+        return bad("max_surface_variation", "must be in (0, 1/3]");
+    }
+    return OkStatus();
+}
+
+Points VoxelDownsample(const Points& points, double voxel_m) {
+    const float inv = static_cast<float>(1.0 / voxel_m);
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        keyed[i] = {VoxelKey(points[i], inv), static_cast<std::uint32_t>(i)};
+    }
+    std::sort(keyed.begin(), keyed.end());
+    Points out;
+    for (std::size_t i = 0; i < keyed.size();) {
+        std::size_t j = i;
+        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        while (j < keyed.size() && keyed[j].first == keyed[i].first) {
+            sum += points[keyed[j].second].cast<double>();
+            ++j;
+        }
+        out.push_back((sum / static_cast<double>(j - i)).cast<float>());
+        i = j;
+    }
+    return out;
+}
+
+OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config) {
+    OrientedPoints out;
+    Points voxels = VoxelDownsample(points, config.voxel_m);
+    if (voxels.size() > static_cast<std::size_t>(config.max_points)) {
+        // Surface samples scale with 1 / voxel², so this voxel lands near max_points.
+        const double grow = std::sqrt(static_cast<double>(voxels.size()) / config.max_points);
+        voxels = VoxelDownsample(points, config.voxel_m * grow);
+    }
+    if (voxels.size() < static_cast<std::size_t>(config.normal_neighbors) + 1) return out;
+    pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
+    cloud->reserve(voxels.size());
+    for (const auto& p : voxels) cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+    if (config.outlier_neighbors > 0) {
+        pcl::PointCloud<pcl::PointXYZ>::Ptr kept(new pcl::PointCloud<pcl::PointXYZ>);
+        pcl::StatisticalOutlierRemoval<pcl::PointXYZ> sor;
+        sor.setInputCloud(cloud);
+        sor.setMeanK(config.outlier_neighbors);
+        sor.setStddevMulThresh(config.outlier_std_ratio);
+        sor.filter(*kept);
+        cloud = kept;
+    }
+    if (cloud->size() < static_cast<std::size_t>(config.normal_neighbors) + 1) return out;
+    pcl::PointCloud<pcl::Normal> normals;
+    pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
+    ne.setInputCloud(cloud);
+    ne.setSearchMethod(
+        pcl::search::KdTree<pcl::PointXYZ>::Ptr(new pcl::search::KdTree<pcl::PointXYZ>));
+    ne.setKSearch(config.normal_neighbors);
+    ne.compute(normals);
+    for (std::size_t i = 0; i < cloud->size(); ++i) {
+        const pcl::Normal& n = normals[i];
+        if (!std::isfinite(n.normal_x) || !std::isfinite(n.normal_y) ||
+            !std::isfinite(n.normal_z)) {
+            continue;
+        }
+        if (n.curvature > config.max_surface_variation) continue;
+        const pcl::PointXYZ& p = (*cloud)[i];
+        out.points.emplace_back(p.x, p.y, p.z);
+        out.normals.push_back(Eigen::Vector3f(n.normal_x, n.normal_y, n.normal_z).normalized());
+    }
+    return out;
+}
+
+}  // namespace boxd

@@ -1,0 +1,33 @@
+#pragma once
+// Stage 2c: the sparse clouds registration works on: voxel downsampling, statistical outlier
+// removal and normal estimation of one view's object points.
+
+#include "pipeline/point_cloud.h"
+#include "pipeline/result.h"
+
+namespace boxd {
+
+struct RegistrationCloudConfig {
+    double voxel_m = 0.006;          // voxel grid leaf size
+    int outlier_neighbors = 8;       // statistical outlier removal: k nearest neighbours ...
+    double outlier_std_ratio = 2.0;  // ... and the mean-distance threshold in standard deviations
+    int normal_neighbors = 10;       // k nearest neighbours for the normal's plane fit
+    // Large objects get a proportionally larger voxel so that a view stays near this many
+    // points (registration time grows with it, its accuracy hardly).
+    int max_points = 3000;
+    // Points whose neighbourhood is not planar (surface variation λ0 / Σλ above this, Pauly et
+    // al. 2002) sit on edges and corners: their normals are blends that pull ICP sideways.
+    double max_surface_variation = 0.02;
+
+    // Returns an error naming the first invalid field (prefixed with `where`), or Ok.
+    Status Validate(const std::string& where) const;
+};
+
+// Returns the downsampled, outlier-free cloud of `points` with unit normals. Deterministic: the
+// voxel centroids come out in voxel-key order.
+OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config);
+
+// Returns the centroids of the occupied voxels of size `voxel_m`, in voxel-key order.
+Points VoxelDownsample(const Points& points, double voxel_m);
+
+}  // namespace boxd

@@ -1,0 +1,139 @@
+#include "pipeline/table_plane.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+
+namespace boxd {
+
+namespace {
+
+Status Bad(const std::string& field, const std::string& why) {
+    return Error{"INVALID_CONFIG", "table_plane." + field + ": " + why};
+}
+
+// Robust sigma from the median absolute deviation (1.4826 * MAD for a normal distribution).
+double RobustSigma(std::vector<double> abs_residuals) {
+    if (abs_residuals.empty()) return 0.0;
+    auto mid = abs_residuals.begin() + static_cast<long>(abs_residuals.size() / 2);
+    std::nth_element(abs_residuals.begin(), mid, abs_residuals.end());
+    return 1.4826 * *mid;
+}
+
+struct Plane {
+    Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+    double d = 0.0;  // normal . p + d = 0
+};
+
+// Least-squares plane through `pts` (smallest eigenvector of the scatter matrix), with the
+// normal oriented like `up`.
+Plane FitPlane(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& up) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& p : pts) mean += p;
+    mean /= static_cast<double>(pts.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const auto& p : pts) cov += (p - mean) * (p - mean).transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+    Plane plane;
+    plane.normal = es.eigenvectors().col(0);
+    if (plane.normal.dot(up) < 0.0) plane.normal = -plane.normal;
+    plane.d = -plane.normal.dot(mean);
+    return plane;
+}
+
+}  // namespace
+
+Status TablePlaneConfig::Validate() const {
+    if (!(search_band_m > 0.0 && search_band_m < 0.2)) return Bad("search_band_m", "in (0, 0.2)");
+    if (!(fit_radius_m > 0.0 && fit_radius_m < 2.0)) return Bad("fit_radius_m", "in (0, 2)");
+    if (pixel_stride < 1 || pixel_stride > 32) return Bad("pixel_stride", "must be in 1..32");
+    if (iterations < 1 || iterations > 50) return Bad("iterations", "must be in 1..50");
+    if (!(trim_sigmas >= 1.0)) return Bad("trim_sigmas", "must be >= 1");
+    if (min_points < 3) return Bad("min_points", "must be >= 3");
+    if (!(max_tilt_deg > 0.0)) return Bad("max_tilt_deg", "must be > 0");
+    if (!(max_shift_m > 0.0)) return Bad("max_shift_m", "must be > 0");
+    return OkStatus();
+}
+
+Points BackProjectDepth(const DepthMap& depth, const CameraIntrinsics& camera,
+                        const StationCalibration& calibration, int stride) {
+    Points out;
+    for (int y = 0; y < depth.height; y += stride) {
+        for (int x = 0; x < depth.width; x += stride) {
+            const float z = depth.at(x, y);
+            if (z <= 0.0f) continue;
+            out.push_back(camera.BackProject(x, y, calibration.CorrectDepth(z)).cast<float>());
+        }
+    }
+    return out;
+}
+
+Result<TablePlaneFit> FitTablePlane(const std::vector<DepthMap>& depths,
+                                    const CameraIntrinsics& camera,
+                                    const StationCalibration& calibration,
+                                    const TablePlaneConfig& config) {
+    const Eigen::Isometry3d recorded = calibration.CameraToTable();
+    // Candidate table-top points in the recorded table frame.
+    std::vector<Eigen::Vector3d> pts;
+    for (const DepthMap& depth : depths) {
+        for (const Eigen::Vector3f& pc :
+             BackProjectDepth(depth, camera, calibration, config.pixel_stride)) {
+            const Eigen::Vector3d p = recorded * pc.cast<double>();
+            if (std::abs(p.z()) < config.search_band_m &&
+                p.head<2>().norm() < config.fit_radius_m) {
+                pts.push_back(p);
+            }
+        }
+    }
+    if (static_cast<int>(pts.size()) < config.min_points) {
+        return Error{"INSUFFICIENT_DATA", "too few table-top readings to locate the table (" +
+                                              std::to_string(pts.size()) + ")"};
+    }
+    // Iteratively trimmed least squares: box faces and bumps near the table top are a minority
+    // and fall outside the shrinking band.
+    Plane plane = FitPlane(pts, Eigen::Vector3d::UnitZ());
+    double sigma = 0.0;
+    for (int it = 0; it < config.iterations; ++it) {
+        std::vector<double> abs_res(pts.size());
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+            abs_res[i] = std::abs(plane.normal.dot(pts[i]) + plane.d);
+        }
+        sigma = std::max(RobustSigma(abs_res), 1e-4);
+        std::vector<Eigen::Vector3d> inliers;
+        inliers.reserve(pts.size());
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+            if (abs_res[i] <= config.trim_sigmas * sigma) inliers.push_back(pts[i]);
+        }
+        if (static_cast<int>(inliers.size()) < config.min_points) {
+            return Error{"INSUFFICIENT_DATA", "too few consistent table-top readings"};
+        }
+        plane = FitPlane(inliers, Eigen::Vector3d::UnitZ());
+    }
+    TablePlaneFit fit;
+    fit.points = static_cast<int>(pts.size());
+    fit.residual_sigma_m = sigma;
+    fit.tilt_correction_deg = std::acos(std::clamp(plane.normal.z(), -1.0, 1.0)) * 180.0 / M_PI;
+    fit.height_correction_m = plane.d;  // signed distance of the recorded origin to the plane
+    if (fit.tilt_correction_deg > config.max_tilt_deg ||
+        std::abs(fit.height_correction_m) > config.max_shift_m) {
+        return Error{"REGISTRATION_FAILED",
+                     "the table top is far from the calibration (tilt " +
+                         std::to_string(fit.tilt_correction_deg) + " deg, shift " +
+                         std::to_string(fit.height_correction_m) + " m); recalibrate"};
+    }
+    // New frame expressed in the recorded table frame: z = plane normal, origin = old origin
+    // projected onto the plane, x = old x projected onto the plane.
+    const Eigen::Vector3d z = plane.normal;
+    const Eigen::Vector3d x = (Eigen::Vector3d::UnitX() - z.x() * z).normalized();
+    const Eigen::Vector3d y = z.cross(x);
+    const Eigen::Vector3d origin = -plane.d * z;
+    Eigen::Matrix3d new_to_old;
+    new_to_old << x, y, z;
+    Eigen::Isometry3d old_to_new = Eigen::Isometry3d::Identity();
+    old_to_new.linear() = new_to_old.transpose();
+    old_to_new.translation() = -new_to_old.transpose() * origin;
+    fit.camera_to_table = old_to_new * recorded;
+    return fit;
+}
+
+}  // namespace boxd

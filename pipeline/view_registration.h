@@ -1,0 +1,60 @@
+#pragma once
+// Stages 3 and 4: initial poses from the turntable angles and the ICP edges of the pose graph
+// (neighbouring poses and loop closures between non-neighbours, last-to-first included).
+
+#include <vector>
+
+#include "pipeline/icp.h"
+#include "pipeline/pose_graph.h"
+#include "pipeline/registration_cloud.h"
+#include "pipeline/result.h"
+
+namespace boxd {
+
+struct RegistrationConfig {
+    RegistrationCloudConfig coarse_cloud{0.012, 8, 2.0, 10, 1000, 0.03};
+    RegistrationCloudConfig fine_cloud{0.006, 8, 2.0, 10, 3000, 0.02};
+    // Coarse: wide gate on the sparse cloud; fine: narrow gate on the denser one.
+    IcpConfig coarse{.max_correspondence_m = 0.02,
+                     .max_iterations = 20,
+                     .translation_tolerance_m = 1e-4,
+                     .yaw_tolerance_rad = 1e-4,
+                     .robust_scale_m = 0.008};
+    IcpConfig fine{.max_correspondence_m = 0.008,
+                   .max_iterations = 20,
+                   .translation_tolerance_m = 2e-5,
+                   .yaw_tolerance_rad = 2e-5,
+                   .robust_scale_m = 0.003};
+    int max_pose_step = 3;  // pairs up to this many poses apart (cyclically) are aligned ...
+    double max_pair_angle_deg = 100.0;  // ... when their turntable angles differ by at most this
+    double min_fitness = 0.3;           // an alignment with fewer matched points is not an edge
+    double max_rmse_m = 0.006;          // nor one with a larger point-to-plane RMSE
+    int threads = 2;
+
+    // Returns an error naming the first invalid field, or Ok.
+    Status Validate() const;
+};
+
+// Per view: the coarse and the fine registration cloud.
+struct ViewClouds {
+    OrientedPoints coarse;
+    OrientedPoints fine;
+};
+
+struct EdgeStats {
+    int attempted = 0;
+    int accepted = 0;
+    double mean_rmse_m = 0.0;  // over accepted edges
+};
+
+// Returns node k's initial pose: the rotation by -angle_k (relative to pose 0) about the axis,
+// which maps view k's points back into the frame of pose 0.
+std::vector<Se2> TurntablePoses(const std::vector<double>& table_angles_rad);
+
+// Returns the graph edges: each selected pair is aligned coarse-then-fine from the turntable
+// model's relative pose; failed alignments are left out. Deterministic for any thread count.
+std::vector<PoseEdge> RegisterViewPairs(const std::vector<ViewClouds>& views,
+                                        const std::vector<double>& table_angles_rad,
+                                        const RegistrationConfig& config, EdgeStats* stats);
+
+}  // namespace boxd

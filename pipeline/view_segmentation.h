@@ -1,0 +1,46 @@
+#pragma once
+// Stage 2b: one view's object points. Back-projects an averaged depth map into the (refitted)
+// table frame and keeps the measuring volume: a cylinder above the table top around the axis.
+
+#include <Eigen/Geometry>
+
+#include "pipeline/camera.h"
+#include "pipeline/depth_image.h"
+#include "pipeline/point_cloud.h"
+#include "pipeline/result.h"
+#include "pipeline/station_calibration.h"
+
+namespace boxd {
+
+struct SegmentationConfig {
+    double cylinder_radius_m = 0.55;  // measuring volume radius about the axis
+    double min_height_m = 0.008;      // above the table top: below this is table (and noise)
+    double max_height_m = 1.5;
+    // Readings above the table just outside the cylinder (within this band) mean the object
+    // leaves the measuring volume.
+    double outside_band_m = 0.2;
+    int border_margin_px = 2;  // object readings this close to the image border are "cut"
+    // Fusion and box fitting use every n-th pixel in x and y: at 1 m the sensor samples the box
+    // every ~2 mm, far denser than the fits need, and the face means stay unbiased.
+    int fusion_pixel_stride = 2;
+
+    // Returns an error naming the first invalid field, or Ok.
+    Status Validate() const;
+};
+
+struct SegmentedView {
+    Points points;           // object points, table frame (every pixel)
+    Points fusion_points;    // the subset on the fusion_pixel_stride grid
+    int border_points = 0;   // object points within border_margin_px of the image border
+    int outside_points = 0;  // readings above the table just outside the cylinder
+    int valid_pixels = 0;    // pixels with a reading in the averaged map
+};
+
+// Returns the object points of `depth` in the table frame given by `camera_to_table`, with the
+// counts the refusal checks need.
+SegmentedView SegmentView(const DepthMap& depth, const CameraIntrinsics& camera,
+                          const StationCalibration& calibration,
+                          const Eigen::Isometry3d& camera_to_table,
+                          const SegmentationConfig& config);
+
+}  // namespace boxd
