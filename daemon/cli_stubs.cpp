@@ -8,7 +8,8 @@ namespace boxd::cli {
 
 namespace {
 
-void AddStub(CLI::App& app, Runner& run, const char* name, const char* description) {
+[[maybe_unused]] void AddStub(CLI::App& app, Runner& run, const char* name,
+                              const char* description) {
     CLI::App* sub = app.add_subcommand(name, description);
     sub->allow_extras();
     sub->callback([&run, name] {
@@ -24,8 +25,8 @@ void AddStub(CLI::App& app, Runner& run, const char* name, const char* descripti
 void AddServe(CLI::App& app, Runner& run) {
     AddStub(app, run, "serve", "Run the daemon (REST/JSON API)");
 }
-void AddCalibrate(CLI::App& app, Runner& run) {
-    AddStub(app, run, "calibrate", "Estimate the station calibration from a reference box");
+void AddMeasure(CLI::App& app, Runner& run) {
+    AddStub(app, run, "measure", "Measure a recorded session offline");
 }
 
 }  // namespace boxd::cli

@@ -1,0 +1,346 @@
+#include "calibration/joint_refinement.h"
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+namespace boxd {
+
+namespace {
+
+// Point groups: the table top and the five visible faces of the box.
+enum Group { kTable = 0, kPlusU, kMinusU, kPlusV, kMinusV, kTop, kGroups };
+
+constexpr int kMinGroupPoints = 30;
+
+// One pose's pixels with their back-projection ray already turned into the base frame:
+// base * p = a * z + t0, where z is the corrected depth.
+struct PosePoints {
+    std::vector<Eigen::Vector3d> a;
+    std::vector<double> raw_z;
+};
+
+// Table coordinates of a pixel (see JointState).
+template <typename T>
+void TablePoint(const Eigen::Vector3d& a, double raw_z, const Eigen::Vector3d& t0, const T* frame,
+                const T* depth, T* q) {
+    const T z = T(raw_z) * depth[1] + depth[0];
+    const T d[3] = {T(a.x()) * z + T(t0.x()) - frame[2], T(a.y()) * z + T(t0.y()) - frame[3],
+                    T(a.z()) * z + T(t0.z()) - frame[4]};
+    const T inverse_tilt[3] = {-frame[0], -frame[1], T(0.0)};
+    ceres::AngleAxisRotatePoint(inverse_tilt, d, q);
+}
+
+// Box coordinates (u along the length, v along the width) of table point q seen at table
+// angle `angle`: the table turned by +angle about z, so the point sat at R(-angle) q at pose 0.
+template <typename T>
+void BoxPoint(const T* q, const T* box, const T* angle, T* u, T* v) {
+    using std::cos;
+    using std::sin;
+    const T ca = cos(angle[0]), sa = sin(angle[0]);
+    const T x0 = ca * q[0] + sa * q[1] - box[0];
+    const T y0 = -sa * q[0] + ca * q[1] - box[1];
+    const T cb = cos(box[2]), sb = sin(box[2]);
+    *u = cb * x0 + sb * y0;
+    *v = -sb * x0 + cb * y0;
+}
+
+// Signed distance outside face `group` of the reference box.
+template <typename T>
+T FaceDistance(int group, const T& u, const T& v, const T& z, const BoxDimensions& ref) {
+    const double hl = 0.5 * ref.length_m, hw = 0.5 * ref.width_m;
+    switch (group) {
+        case kPlusU:
+            return u - T(hl);
+        case kMinusU:
+            return -u - T(hl);
+        case kPlusV:
+            return v - T(hw);
+        case kMinusV:
+            return -v - T(hw);
+        default:
+            return z - T(ref.height_m);
+    }
+}
+
+struct TableCost {
+    const PosePoints* pts;
+    std::vector<int> idx;
+    Eigen::Vector3d t0;
+    double weight;
+
+    template <typename T>
+    bool operator()(const T* frame, const T* depth, T* r) const {
+        for (std::size_t i = 0; i < idx.size(); ++i) {
+            const auto k = static_cast<std::size_t>(idx[i]);
+            T q[3];
+            TablePoint(pts->a[k], pts->raw_z[k], t0, frame, depth, q);
+            r[i] = T(weight) * q[2];
+        }
+        return true;
+    }
+};
+
+struct FaceCost {
+    const PosePoints* pts;
+    std::vector<int> idx;
+    Eigen::Vector3d t0;
+    double weight;
+    int group;
+    BoxDimensions ref;
+
+    template <typename T>
+    bool operator()(const T* frame, const T* depth, const T* box, const T* angle, T* r) const {
+        for (std::size_t i = 0; i < idx.size(); ++i) {
+            const auto k = static_cast<std::size_t>(idx[i]);
+            T q[3], u, v;
+            TablePoint(pts->a[k], pts->raw_z[k], t0, frame, depth, q);
+            BoxPoint(q, box, angle, &u, &v);
+            r[i] = T(weight) * FaceDistance(group, u, v, q[2], ref);
+        }
+        return true;
+    }
+};
+
+// The points of one (pose, group) with their current residuals.
+struct Assignment {
+    std::array<std::vector<int>, kGroups> idx;
+    std::array<std::vector<double>, kGroups> res;
+};
+
+double RobustSigma(std::vector<double> r) {
+    if (r.empty()) return 0.0;
+    for (double& x : r) x = std::abs(x);
+    auto mid = r.begin() + static_cast<long>(r.size() / 2);
+    std::nth_element(r.begin(), mid, r.end());
+    return 1.4826 * *mid;
+}
+
+// Assigns every pixel of a pose to the table, one face, or nothing, at the current state.
+Assignment Assign(const PosePoints& pts, const Eigen::Vector3d& t0, const JointState& s,
+                  double angle, const BoxDimensions& ref, const std::array<double, kGroups>& band,
+                  const JointRefinementConfig& cfg) {
+    Assignment out;
+    const double hl = 0.5 * ref.length_m, hw = 0.5 * ref.width_m, h = ref.height_m;
+    const double m = cfg.face_edge_margin_m;
+    const double outer2 = cfg.table_ring_outer_m * cfg.table_ring_outer_m;
+    for (std::size_t k = 0; k < pts.a.size(); ++k) {
+        double q[3], u, v;
+        TablePoint(pts.a[k], pts.raw_z[k], t0, s.frame, s.depth, q);
+        BoxPoint(q, s.box, &angle, &u, &v);
+        const double z = q[2];
+        const bool outside_footprint =
+            std::abs(u) > hl + cfg.table_ring_inner_m || std::abs(v) > hw + cfg.table_ring_inner_m;
+        if (outside_footprint) {
+            if (std::abs(z) < band[kTable] && q[0] * q[0] + q[1] * q[1] < outer2) {
+                out.idx[kTable].push_back(static_cast<int>(k));
+                out.res[kTable].push_back(z);
+            }
+            continue;
+        }
+        // Candidate faces: the point lies over the face's interior (edge margins excluded).
+        int best = -1;
+        double best_d = 0.0;
+        auto consider = [&](int g, bool inside) {
+            if (!inside) return;
+            const double d = FaceDistance(g, u, v, z, ref);
+            if (std::abs(d) < band[static_cast<std::size_t>(g)] &&
+                (best < 0 || std::abs(d) < std::abs(best_d))) {
+                best = g;
+                best_d = d;
+            }
+        };
+        const bool side_height = z > m && z < h - m;
+        consider(kPlusU, side_height && std::abs(v) < hw - m);
+        consider(kMinusU, side_height && std::abs(v) < hw - m);
+        consider(kPlusV, side_height && std::abs(u) < hl - m);
+        consider(kMinusV, side_height && std::abs(u) < hl - m);
+        consider(kTop, std::abs(u) < hl - m && std::abs(v) < hw - m);
+        if (best >= 0) {
+            out.idx[static_cast<std::size_t>(best)].push_back(static_cast<int>(k));
+            out.res[static_cast<std::size_t>(best)].push_back(best_d);
+        }
+    }
+    return out;
+}
+
+double MaxEigen2(const Eigen::Matrix2d& m) {
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(m);
+    return std::max(0.0, es.eigenvalues().maxCoeff());
+}
+
+}  // namespace
+
+Eigen::Isometry3d JointCameraToTable(const JointState& s) {
+    const Eigen::Vector3d tilt(s.frame[0], s.frame[1], 0.0);
+    const Eigen::Matrix3d r =
+        tilt.norm() > 0.0 ? Eigen::AngleAxisd(tilt.norm(), tilt.normalized()).toRotationMatrix()
+                          : Eigen::Matrix3d::Identity();
+    const Eigen::Vector3d c(s.frame[2], s.frame[3], s.frame[4]);
+    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+    t.linear() = r.transpose() * s.base.linear();
+    t.translation() = r.transpose() * (s.base.translation() - c);
+    return t;
+}
+
+Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
+                                    const CameraIntrinsics& camera, const BoxDimensions& reference,
+                                    const JointState& init, const JointRefinementConfig& config) {
+    const std::size_t n = views.size();
+    if (init.angle_rad.size() != n) {
+        return Error{"INVALID_CONFIG", "joint refinement: one angle per view is needed"};
+    }
+    (void)camera;
+    const Eigen::Matrix3d r0 = init.base.linear();
+    const Eigen::Vector3d t0 = init.base.translation();
+    std::vector<PosePoints> pts(n);
+    for (std::size_t k = 0; k < n; ++k) {
+        const CalibrationView& v = views[k];
+        pts[k].a.reserve(v.ray.size());
+        for (std::size_t i = 0; i < v.ray.size(); ++i) {
+            pts[k].a.push_back(r0 * Eigen::Vector3d(v.ray[i].x(), v.ray[i].y(), 1.0));
+            pts[k].raw_z.push_back(v.raw_z_m[i]);
+        }
+    }
+
+    JointSolution sol;
+    sol.state = init;
+    JointState& s = sol.state;
+    // Per pose and group: the band of the next assignment and the weight of its residuals.
+    std::vector<std::array<double, kGroups>> band(n), weight(n);
+    for (std::size_t k = 0; k < n; ++k) band[k].fill(config.initial_band_m);
+
+    ceres::Solver::Summary summary;
+    std::unique_ptr<ceres::Problem> problem;
+    for (int outer = 0; outer < config.outer_iterations; ++outer) {
+        std::vector<Assignment> assign(n);
+        for (std::size_t k = 0; k < n; ++k) {
+            assign[k] = Assign(pts[k], t0, s, s.angle_rad[k], reference, band[k], config);
+            for (int g = 0; g < kGroups; ++g) {
+                const double sigma = std::max(
+                    RobustSigma(assign[k].res[static_cast<std::size_t>(g)]), config.sigma_floor_m);
+                weight[k][static_cast<std::size_t>(g)] = 1.0 / sigma;
+                band[k][static_cast<std::size_t>(g)] =
+                    std::max(config.band_sigmas * sigma, config.min_band_m);
+            }
+        }
+        ceres::Problem::Options popt;
+        popt.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+        problem = std::make_unique<ceres::Problem>(popt);
+        problem->AddParameterBlock(s.frame, 5);
+        problem->AddParameterBlock(s.depth, 2);
+        if (!config.estimate_depth_scale) {
+            problem->SetManifold(s.depth, new ceres::SubsetManifold(2, {1}));
+        }
+        problem->AddParameterBlock(s.box, 3);
+        for (std::size_t k = 0; k < n; ++k) problem->AddParameterBlock(&s.angle_rad[k], 1);
+        problem->SetParameterBlockConstant(&s.angle_rad[0]);
+        sol.table_points = 0;
+        sol.face_points = 0;
+        for (std::size_t k = 0; k < n; ++k) {
+            for (int g = 0; g < kGroups; ++g) {
+                const auto gi = static_cast<std::size_t>(g);
+                const std::vector<int>& idx = assign[k].idx[gi];
+                if (static_cast<int>(idx.size()) < kMinGroupPoints) continue;
+                const int m = static_cast<int>(idx.size());
+                if (g == kTable) {
+                    auto* f = new TableCost{&pts[k], idx, t0, weight[k][gi]};
+                    problem->AddResidualBlock(
+                        new ceres::AutoDiffCostFunction<TableCost, ceres::DYNAMIC, 5, 2>(f, m),
+                        nullptr, s.frame, s.depth);
+                    sol.table_points += m;
+                } else {
+                    auto* f = new FaceCost{&pts[k], idx, t0, weight[k][gi], g, reference};
+                    problem->AddResidualBlock(
+                        new ceres::AutoDiffCostFunction<FaceCost, ceres::DYNAMIC, 5, 2, 3, 1>(f, m),
+                        nullptr, s.frame, s.depth, s.box, &s.angle_rad[k]);
+                    sol.face_points += m;
+                }
+            }
+        }
+        if (sol.table_points < 500 || sol.face_points < 500) {
+            return Error{"NOT_CONVERGED",
+                         "too few points on the table (" + std::to_string(sol.table_points) +
+                             ") or on the reference box faces (" + std::to_string(sol.face_points) +
+                             ") agree with the model"};
+        }
+        ceres::Solver::Options opt;
+        opt.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+        opt.max_num_iterations = config.max_solver_iterations;
+        opt.num_threads = config.threads;
+        opt.function_tolerance = 1e-12;
+        opt.parameter_tolerance = 1e-12;
+        opt.gradient_tolerance = 1e-14;
+        ceres::Solve(opt, problem.get(), &summary);
+        spdlog::debug(
+            "calibrate: round {}: {} table + {} face points, cost {:.4g} -> {:.4g}, offset "
+            "{:.5f} m",
+            outer, sol.table_points, sol.face_points, summary.initial_cost, summary.final_cost,
+            s.depth[0]);
+        if (!summary.IsSolutionUsable()) {
+            return Error{"NOT_CONVERGED",
+                         "the joint calibration problem did not converge: " + summary.message};
+        }
+    }
+    sol.converged = summary.termination_type == ceres::CONVERGENCE;
+
+    // Unweighted RMS figures at the solution.
+    {
+        double table_sum = 0.0, face_sum = 0.0;
+        long table_n = 0, face_n = 0;
+        for (std::size_t k = 0; k < n; ++k) {
+            const Assignment a = Assign(pts[k], t0, s, s.angle_rad[k], reference, band[k], config);
+            for (int g = 0; g < kGroups; ++g) {
+                for (double r : a.res[static_cast<std::size_t>(g)]) {
+                    (g == kTable ? table_sum : face_sum) += r * r;
+                    ++(g == kTable ? table_n : face_n);
+                }
+            }
+        }
+        sol.table_rms_m = table_n > 0 ? std::sqrt(table_sum / static_cast<double>(table_n)) : 0.0;
+        sol.face_rms_m = face_n > 0 ? std::sqrt(face_sum / static_cast<double>(face_n)) : 0.0;
+    }
+
+    // Uncertainty: the covariance of the weighted least-squares problem (residuals whitened by
+    // their group's robust sigma), scaled by the reduced chi-square. It is the statistical part
+    // only: systematic errors of the sensor are not in it.
+    ceres::Covariance::Options copt;
+    copt.algorithm_type = ceres::DENSE_SVD;
+    copt.null_space_rank = -1;
+    copt.num_threads = config.threads;
+    ceres::Covariance covariance(copt);
+    std::vector<std::pair<const double*, const double*>> blocks = {{s.frame, s.frame},
+                                                                   {s.depth, s.depth}};
+    const int residuals = problem->NumResiduals();
+    const int params = problem->NumParameters() - (config.estimate_depth_scale ? 0 : 1) - 1;
+    const double chi2 = residuals > params ? 2.0 * summary.final_cost / (residuals - params) : 1.0;
+    if (covariance.Compute(blocks, problem.get())) {
+        double cf[25], cd[4];
+        covariance.GetCovarianceBlock(s.frame, s.frame, cf);
+        covariance.GetCovarianceBlock(s.depth, s.depth, cd);
+        const Eigen::Map<const Eigen::Matrix<double, 5, 5, Eigen::RowMajor>> f(cf);
+        sol.sigma_axis_deg = std::sqrt(chi2 * MaxEigen2(f.block<2, 2>(0, 0))) * 180.0 / M_PI;
+        sol.sigma_center_m = std::sqrt(chi2 * MaxEigen2(f.block<2, 2>(2, 2)));
+        sol.sigma_height_m = std::sqrt(chi2 * std::max(0.0, f(4, 4)));
+        sol.sigma_depth_offset_m = std::sqrt(chi2 * std::max(0.0, cd[0]));
+        sol.sigma_depth_scale =
+            config.estimate_depth_scale ? std::sqrt(chi2 * std::max(0.0, cd[3])) : 0.0;
+    } else {
+        spdlog::warn("calibrate: the covariance of the estimate could not be computed");
+    }
+
+    const Eigen::Isometry3d cam_to_table = JointCameraToTable(s);
+    const Eigen::Isometry3d table_to_cam = cam_to_table.inverse();
+    sol.calibration.table_center_m = table_to_cam.translation();
+    sol.calibration.table_axis = table_to_cam.linear().col(2).normalized();
+    sol.calibration.depth_offset_m = s.depth[0];
+    sol.calibration.depth_scale = s.depth[1];
+    return sol;
+}
+
+}  // namespace boxd

@@ -1,0 +1,327 @@
+#include "calibration/station_calibrator.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "calibration/joint_refinement.h"
+#include "calibration/turntable_centre.h"
+#include "pipeline/parallel_for.h"
+
+namespace boxd {
+
+namespace {
+
+namespace code = calibration_error;
+
+std::string Fmt(const char* fmt, double a, double b = 0.0, double c = 0.0) {
+    char buf[256];
+    std::snprintf(buf, sizeof(buf), fmt, a, b, c);
+    return buf;
+}
+
+BoxDimensions Sorted(const BoxDimensions& d) {
+    return {std::max(d.length_m, d.width_m), std::min(d.length_m, d.width_m), d.height_m};
+}
+
+// The pipeline stages' defaults, widened where a calibration session differs from a measuring
+// one: the recorded calibration may be off by centimetres and degrees (that is why the station
+// is being calibrated), so the table top is searched in a wider band.
+}  // namespace
+
+MeasureConfig CalibrationMeasureDefaults() {
+    MeasureConfig c;
+    c.table_plane.search_band_m = 0.06;
+    c.table_plane.max_tilt_deg = 10.0;
+    c.table_plane.max_shift_m = 0.1;
+    return c;
+}
+
+namespace {
+
+// What the pipeline stages give the joint refinement to start from.
+struct InitialEstimate {
+    std::vector<DepthMap> depths;
+    Eigen::Isometry3d camera_to_table;  // refitted table frame of pose 0, origin at the centre
+    std::vector<Se2> poses;             // registered views (into pose 0), about that origin
+    BoxFit box;                         // free fit of the reference box, same frame
+};
+
+// Runs the measurement pipeline's stages with the recorded calibration: averaged depth maps,
+// table plane, segmentation, pairwise ICP, pose graph, fusion and the footprint box fit; then
+// moves the table frame's origin to the turntable centre the registered views rotate about.
+Result<InitialEstimate> EstimateInitial(const Session& session, const MeasureConfig& mc) {
+    InitialEstimate est;
+    const int n = static_cast<int>(session.poses.size());
+    est.depths.resize(static_cast<std::size_t>(n));
+    std::vector<std::string> errors(static_cast<std::size_t>(n));
+    ParallelFor(n, mc.threads, [&](int k) {
+        const auto i = static_cast<std::size_t>(k);
+        auto avg =
+            AverageDepthFrames(session.poses[i].frames, session.camera.depth_unit_m, mc.averaging);
+        if (!avg) {
+            errors[i] = avg.error().message;
+            return;
+        }
+        est.depths[i] = RemoveFlyingPixels(*avg, mc.flying_pixels);
+    });
+    for (int k = 0; k < n; ++k) {
+        const auto i = static_cast<std::size_t>(k);
+        if (!errors[i].empty()) {
+            return Error{code::kTableNotVisible, "pose " + std::to_string(k) + ": " + errors[i]};
+        }
+        const double valid = ValidFraction(est.depths[i]);
+        if (valid < mc.refusal.min_pose_valid_fraction) {
+            return Error{code::kTableNotVisible, "pose " + std::to_string(k) +
+                                                     " has depth readings in only " +
+                                                     Fmt("%.1f%% of its pixels", 100.0 * valid)};
+        }
+    }
+    auto table = FitTablePlane(est.depths, session.camera, session.calibration, mc.table_plane);
+    if (!table) {
+        return Error{
+            code::kTableNotVisible,
+            "the table top around the reference box is not visible: " + table.error().message};
+    }
+
+    std::vector<SegmentedView> views(static_cast<std::size_t>(n));
+    std::vector<ViewClouds> clouds(static_cast<std::size_t>(n));
+    ParallelFor(n, mc.threads, [&](int k) {
+        const auto i = static_cast<std::size_t>(k);
+        views[i] = SegmentView(est.depths[i], session.camera, session.calibration,
+                               table->camera_to_table, mc.segmentation);
+        clouds[i].coarse = BuildRegistrationCloud(views[i].points, mc.registration.coarse_cloud);
+        clouds[i].fine = BuildRegistrationCloud(views[i].points, mc.registration.fine_cloud);
+    });
+    long object_points = 0;
+    for (int k = 0; k < n; ++k) {
+        const SegmentedView& v = views[static_cast<std::size_t>(k)];
+        object_points += static_cast<long>(v.points.size());
+        if (v.border_points > mc.refusal.max_border_points) {
+            return Error{
+                code::kNoReference,
+                "the reference box is cut by the image border in pose " + std::to_string(k)};
+        }
+    }
+    if (object_points < mc.refusal.min_object_points) {
+        return Error{code::kNoReference, "no reference box stands on the table"};
+    }
+
+    std::vector<double> angles(static_cast<std::size_t>(n));
+    for (int k = 0; k < n; ++k) {
+        angles[static_cast<std::size_t>(k)] = session.PoseAngleRad(static_cast<std::size_t>(k));
+    }
+    PoseGraph graph;
+    graph.poses = TurntablePoses(angles);
+    for (const Se2& p : graph.poses) graph.commanded_yaw.push_back(p.yaw);
+    EdgeStats edge_stats;
+    graph.edges = RegisterViewPairs(clouds, angles, mc.registration, &edge_stats);
+    auto report = OptimizePoseGraph(graph, mc.pose_graph);
+    if (!report) {
+        return Error{code::kBoxMoved,
+                     "the views of the reference box do not register: " + report.error().message};
+    }
+    const RefusalConfig& refuse = mc.refusal;
+    if (report->max_model_yaw_deviation_rad * 180.0 / M_PI > refuse.max_model_yaw_deviation_deg ||
+        report->max_model_translation_deviation_m > refuse.max_model_translation_deviation_m) {
+        return Error{code::kBoxMoved, "the views disagree with the turntable motion (" +
+                                          Fmt("%.1f deg, %.1f mm",
+                                              report->max_model_yaw_deviation_rad * 180.0 / M_PI,
+                                              report->max_model_translation_deviation_m * 1000.0) +
+                                          "): the reference box moved on the table"};
+    }
+    if (report->active_edges == 0 ||
+        report->unconstrained_nodes > refuse.max_unconstrained_fraction * n) {
+        return Error{code::kBoxMoved, "too few views of the reference box could be registered (" +
+                                          std::to_string(report->unconstrained_nodes) + " of " +
+                                          std::to_string(n) + " unregistered)"};
+    }
+
+    // The centre the registered views rotate about ((I - R_k) c = t_k, least squares).
+    auto centre = FitTurntableCentre(graph.poses);
+    if (!centre) return Error{code::kTooFewPoses, centre.error().message};
+    spdlog::debug("calibrate: registered views turn about ({:.4f}, {:.4f}) m, rms {:.4f} m",
+                  centre->center.x(), centre->center.y(), centre->rms_m);
+
+    std::vector<Points> view_points(static_cast<std::size_t>(n));
+    for (int k = 0; k < n; ++k) {
+        view_points[static_cast<std::size_t>(k)] =
+            std::move(views[static_cast<std::size_t>(k)].points);
+    }
+    FusedCloud fused = FuseViews(view_points, graph.poses, mc.fusion);
+    auto fit = FitFootprintBox(fused.points, mc.box_fit);
+    if (!fit) {
+        return Error{code::kNoReference,
+                     "the reference box could not be measured: " + fit.error().message};
+    }
+    const ConsistencyReport consistency = CheckViewConsistency(fused, n, *fit, mc.fusion);
+    if (!consistency.inconsistent_views.empty()) {
+        return Error{code::kBoxMoved,
+                     "view " + std::to_string(consistency.worst_view) +
+                         " disagrees with the others: the reference box moved on the table"};
+    }
+
+    // Move the origin to the centre: registered motions become rotations about the origin.
+    Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
+    shift.translation() = Eigen::Vector3d(-centre->center.x(), -centre->center.y(), 0.0);
+    est.camera_to_table = shift * table->camera_to_table;
+    for (const Se2& p : graph.poses) {
+        est.poses.push_back(Se2::RotationAbout(p.yaw, Eigen::Vector2d::Zero()));
+    }
+    est.box = *fit;
+    est.box.center_m -= centre->center;
+    return est;
+}
+
+// Pixels of every pose near the table top or the reference box (for the joint problem).
+std::vector<CalibrationView> CollectViews(const std::vector<DepthMap>& depths,
+                                          const Session& session, const InitialEstimate& est,
+                                          const BoxDimensions& ref, const CalibrationConfig& cfg) {
+    const CameraIntrinsics& cam = session.camera;
+    const StationCalibration& recorded = session.calibration;
+    const double reach =
+        est.box.center_m.norm() + 0.5 * std::hypot(ref.length_m, ref.width_m) + 0.05;
+    const double radius = std::max(cfg.table_ring_outer_m + 0.02, reach);
+    const double zmin = -0.05, zmax = ref.height_m * 1.15 + 0.05;
+    std::vector<CalibrationView> out(depths.size());
+    for (std::size_t k = 0; k < depths.size(); ++k) {
+        const DepthMap& d = depths[k];
+        for (int v = 0; v < d.height; v += cfg.pixel_stride) {
+            for (int u = 0; u < d.width; u += cfg.pixel_stride) {
+                const float raw = d.at(u, v);
+                if (raw <= 0.0f) continue;
+                const Eigen::Vector3d p =
+                    est.camera_to_table * cam.BackProject(u, v, recorded.CorrectDepth(raw));
+                if (p.z() < zmin || p.z() > zmax || p.head<2>().norm() > radius) continue;
+                out[k].ray.emplace_back(static_cast<float>((u - cam.cx) / cam.fx),
+                                        static_cast<float>((v - cam.cy) / cam.fy));
+                out[k].raw_z_m.push_back(raw);
+            }
+        }
+    }
+    return out;
+}
+
+double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
+}
+
+}  // namespace
+
+Status CalibrationConfig::Validate() const {
+    auto bad = [](const std::string& f, const std::string& why) -> Status {
+        return Error{code::kInvalidConfig, "calibration." + f + ": " + why};
+    };
+    if (Status s = measure.Validate(); !s) return s;
+    if (min_poses < 3) return bad("min_poses", "must be >= 3");
+    if (!(max_reference_mismatch > 0.0 && max_reference_mismatch < 1.0)) {
+        return bad("max_reference_mismatch", "must be in (0, 1)");
+    }
+    if (pixel_stride < 1 || pixel_stride > 16) return bad("pixel_stride", "must be in 1..16");
+    if (!(table_ring_inner_m >= 0.0)) return bad("table_ring_inner_m", "must be >= 0");
+    if (!(table_ring_outer_m > table_ring_inner_m)) {
+        return bad("table_ring_outer_m", "must exceed table_ring_inner_m");
+    }
+    if (!(face_edge_margin_m >= 0.0 && face_edge_margin_m < 0.1)) {
+        return bad("face_edge_margin_m", "must be in [0, 0.1)");
+    }
+    if (!(face_band_m > 0.0 && face_band_m < 0.1)) return bad("face_band_m", "must be in (0, 0.1)");
+    if (!(band_sigmas >= 2.0)) return bad("band_sigmas", "must be >= 2");
+    if (outer_iterations < 1 || outer_iterations > 20) {
+        return bad("outer_iterations", "must be in 1..20");
+    }
+    if (max_solver_iterations < 1) return bad("max_solver_iterations", "must be >= 1");
+    return OkStatus();
+}
+
+Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDimensions& reference,
+                                           const CalibrationConfig& config) {
+    if (Status s = config.Validate(); !s) return s.error();
+    const BoxDimensions ref = Sorted(reference);
+    if (!(ref.width_m > 0.0 && ref.height_m > 0.0) || ref.length_m > 2.0 || ref.height_m > 2.0) {
+        return Error{code::kWrongReference,
+                     "the reference size must be positive and at most 2 m per side"};
+    }
+    const int n = static_cast<int>(session.poses.size());
+    if (n < config.min_poses) {
+        return Error{code::kTooFewPoses,
+                     "calibration needs at least " + std::to_string(config.min_poses) +
+                         " poses around the turntable, the session has " + std::to_string(n)};
+    }
+
+    auto est = EstimateInitial(session, config.measure);
+    if (!est) return est.error();
+    CalibrationReport report;
+    report.recorded = session.calibration;
+    report.reference = ref;
+    report.measured_before = {est->box.length_m, est->box.width_m, est->box.height_m};
+    const double mismatch = std::max({std::abs(est->box.length_m / ref.length_m - 1.0),
+                                      std::abs(est->box.width_m / ref.width_m - 1.0),
+                                      std::abs(est->box.height_m / ref.height_m - 1.0)});
+    spdlog::info(
+        "calibrate: reference measures {:.4f} x {:.4f} x {:.4f} m with the recorded "
+        "calibration (stated {:.4f} x {:.4f} x {:.4f} m)",
+        est->box.length_m, est->box.width_m, est->box.height_m, ref.length_m, ref.width_m,
+        ref.height_m);
+    if (mismatch > config.max_reference_mismatch) {
+        return Error{code::kWrongReference,
+                     "the box on the table measures " +
+                         Fmt("%.3f x %.3f x %.3f m", est->box.length_m, est->box.width_m,
+                             est->box.height_m) +
+                         ", not the stated reference " +
+                         Fmt("%.3f x %.3f x %.3f m", ref.length_m, ref.width_m, ref.height_m) +
+                         Fmt(" (%.0f%% off): wrong reference box?", 100.0 * mismatch)};
+    }
+
+    JointState init;
+    init.base = est->camera_to_table;
+    init.depth[0] = session.calibration.depth_offset_m;
+    init.depth[1] = session.calibration.depth_scale;
+    init.box[0] = est->box.center_m.x();
+    init.box[1] = est->box.center_m.y();
+    init.box[2] = std::atan2(est->box.length_axis.y(), est->box.length_axis.x());
+    for (const Se2& p : est->poses) init.angle_rad.push_back(-p.yaw);
+    const std::vector<CalibrationView> views =
+        CollectViews(est->depths, session, *est, ref, config);
+
+    JointRefinementConfig jc;
+    jc.table_ring_inner_m = config.table_ring_inner_m;
+    jc.table_ring_outer_m = config.table_ring_outer_m;
+    jc.face_edge_margin_m = config.face_edge_margin_m;
+    jc.initial_band_m = config.face_band_m;
+    jc.band_sigmas = config.band_sigmas;
+    jc.outer_iterations = config.outer_iterations;
+    jc.max_solver_iterations = config.max_solver_iterations;
+    jc.estimate_depth_scale = config.estimate_depth_scale;
+    jc.threads = config.measure.threads;
+    auto sol = RefineJointly(views, session.camera, ref, init, jc);
+    if (!sol) return sol.error();
+
+    report.calibration = sol->calibration;
+    report.depth_scale_estimated = config.estimate_depth_scale;
+    report.uncertainty = {sol->sigma_center_m, sol->sigma_height_m, sol->sigma_axis_deg,
+                          sol->sigma_depth_offset_m, sol->sigma_depth_scale};
+    report.poses_used = n;
+    report.table_points = sol->table_points;
+    report.face_points = sol->face_points;
+    report.table_rms_m = sol->table_rms_m;
+    report.face_rms_m = sol->face_rms_m;
+    for (int k = 0; k < n; ++k) {
+        const double commanded = session.PoseAngleRad(static_cast<std::size_t>(k));
+        report.pose_angle_corrections_deg.push_back(
+            Se2::WrapAngle(sol->state.angle_rad[static_cast<std::size_t>(k)] - commanded) * 180.0 /
+            M_PI);
+    }
+    report.center_shift_m =
+        (report.calibration.table_center_m - report.recorded.table_center_m).norm();
+    report.axis_change_deg = AngleDeg(report.calibration.table_axis, report.recorded.table_axis);
+    if (Status s = report.calibration.Validate(); !s) {
+        return Error{code::kNotConverged,
+                     "the estimate is not a valid calibration: " + s.error().message};
+    }
+    return report;
+}
+
+}  // namespace boxd
