@@ -22,11 +22,4 @@ namespace {
 
 }  // namespace
 
-void AddServe(CLI::App& app, Runner& run) {
-    AddStub(app, run, "serve", "Run the daemon (REST/JSON API)");
-}
-void AddMeasure(CLI::App& app, Runner& run) {
-    AddStub(app, run, "measure", "Measure a recorded session offline");
-}
-
 }  // namespace boxd::cli

@@ -1,0 +1,293 @@
+#include "daemon/device_station.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <fstream>
+
+#include "calibration/station_calibrator.h"
+#include "pipeline/ply_writer.h"
+#include "pipeline/session_io.h"
+
+namespace boxd {
+
+using nlohmann::json;
+
+namespace {
+
+double MsSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+JobOutput FailedOutput(const std::string& code, const std::string& message) {
+    JobOutput out;
+    out.result.status = MeasurementStatus::kFailed;
+    out.result.reason = MeasurementReason{code, message};
+    return out;
+}
+
+json Vec3(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+}  // namespace
+
+DeviceStation::DeviceStation(DeviceStationConfig config) : config_(std::move(config)) {
+    calibration_source_ = config_.config_file;
+    LoadStoredCalibration();
+}
+
+void DeviceStation::LoadStoredCalibration() {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (config_.calibration_file.empty() || !fs::exists(config_.calibration_file, ec)) return;
+    const auto stored_time = fs::last_write_time(config_.calibration_file, ec);
+    if (ec) return;
+    const auto config_time = fs::last_write_time(config_.config_file, ec);
+    if (!ec && config_.station.calibration && config_time > stored_time) {
+        spdlog::info("calibration: {} is newer than {}; using the config's",
+                     config_.config_file.string(), config_.calibration_file.string());
+        return;
+    }
+    std::ifstream in(config_.calibration_file);
+    const json j = json::parse(in, nullptr, false);
+    StationCalibration c;
+    try {
+        const json& block = j.at("calibration");
+        for (int i = 0; i < 3; ++i) {
+            c.table_center_m[i] = block.at("table_center_m").at(i).get<double>();
+            c.table_axis[i] = block.at("table_axis").at(i).get<double>();
+        }
+        c.depth_offset_m = block.at("depth_offset_m").get<double>();
+        c.depth_scale = block.at("depth_scale").get<double>();
+    } catch (const json::exception& e) {
+        spdlog::error("calibration: ignoring {}: {}", config_.calibration_file.string(), e.what());
+        return;
+    }
+    if (Status s = c.Validate(config_.calibration_file.string()); !s) {
+        spdlog::error("calibration: ignoring {}", s.error().message);
+        return;
+    }
+    config_.station.calibration = c;
+    calibration_source_ = config_.calibration_file;
+    spdlog::info("calibration: using {} (from POST /v1/calibrate)",
+                 config_.calibration_file.string());
+}
+
+DeviceStation::~DeviceStation() { CloseDevices(); }
+
+Status DeviceStation::Open() {
+    CloseDevices();
+    Result<StationDevices> devices = OpenStation(config_.station);
+    if (!devices) {
+        MarkDeviceError(devices.error());
+        return devices.error();
+    }
+    auto opened = std::make_unique<StationDevices>(std::move(*devices));
+    // Homing at start-up finds a faulted or unreachable drive before the first parcel does.
+    if (Status homed = opened->turntable->Home(); !homed) {
+        opened->camera->Close();
+        MarkDeviceError(homed.error());
+        return homed.error();
+    }
+    {
+        std::lock_guard lock(devices_mutex_);
+        turntable_description_ = opened->turntable->Describe();
+        camera_description_ = opened->camera->Describe();
+        device_error_.reset();
+        devices_ = std::move(opened);
+    }
+    open_ = true;
+    spdlog::info("devices up: turntable {}; camera {}", turntable_description_,
+                 camera_description_);
+    return OkStatus();
+}
+
+void DeviceStation::MarkDeviceError(const Error& error) {
+    spdlog::error("device error: {}: {}", error.code, error.message);
+    std::lock_guard lock(devices_mutex_);
+    device_error_ = error;
+    open_ = false;
+}
+
+void DeviceStation::CloseDevices() {
+    std::unique_ptr<StationDevices> devices;
+    {
+        std::lock_guard lock(devices_mutex_);
+        devices = std::move(devices_);
+        open_ = false;
+    }
+    if (devices) {
+        if (devices->turntable) {
+            if (Status s = devices->turntable->Stop(); !s) {
+                spdlog::warn("closing the turntable: {}", s.error().message);
+            }
+        }
+        if (devices->camera) devices->camera->Close();
+    }
+}
+
+Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms) {
+    capture_ms = 0.0;
+    StationDevices* devices = nullptr;
+    {
+        std::lock_guard lock(devices_mutex_);
+        devices = devices_.get();
+    }
+    if (!devices || !open_) return Error{kCameraErrorCode, "the devices are not open"};
+    devices->turntable->ClearStopRequest();
+    const int poses = static_cast<int>(devices->capture.Angles().size());
+    if (ctx.progress) ctx.progress(JobProgress{"capture", 0, poses});
+    CaptureCallbacks callbacks;
+    callbacks.cancel = ctx.cancel;
+    callbacks.on_progress = [&ctx](int pose, int n) {
+        if (ctx.progress) ctx.progress(JobProgress{"capture", pose, n});
+    };
+    const auto t_capture = std::chrono::steady_clock::now();
+    Result<Session> session = CaptureSession(*devices->turntable, *devices->camera,
+                                             devices->capture, devices->station, callbacks);
+    capture_ms = MsSince(t_capture);
+    if (!session) {
+        const Error& e = session.error();
+        if (e.code == kTurntableErrorCode || e.code == kCameraErrorCode) MarkDeviceError(e);
+    }
+    return session;
+}
+
+JobOutput DeviceStation::Measure(const JobContext& ctx) {
+    double capture_ms = 0.0;
+    Result<Session> session = Capture(ctx, capture_ms);
+    if (!session) {
+        JobOutput out = FailedOutput(session.error().code, session.error().message);
+        out.result.timing_ms["capture"] = capture_ms;
+        return out;
+    }
+    const int poses = static_cast<int>(session->poses.size());
+
+    JobOutput out;
+    if (ctx.keep_session) {
+        const auto dir = ctx.scratch_dir / "session";
+        if (Status s = WriteSession(*session, dir); s) {
+            out.files.session_dir = dir;
+        } else {
+            spdlog::warn("measurement {}: session not kept: {}", ctx.id, s.error().message);
+        }
+    }
+    if (ctx.cancelled()) {
+        JobOutput aborted = FailedOutput("ABORTED", "cancelled after the capture");
+        aborted.result.timing_ms["capture"] = capture_ms;
+        aborted.files = out.files;
+        return aborted;
+    }
+
+    // Processing: the pipeline takes the whole session.
+    if (ctx.progress) ctx.progress(JobProgress{"processing", poses, poses});
+    const auto t_processing = std::chrono::steady_clock::now();
+    Result<MeasureOutput> measured = MeasureSession(*session, config_.measure, config_.method);
+    if (!measured) {
+        JobOutput failed = FailedOutput(measured.error().code, measured.error().message);
+        failed.result.timing_ms["capture"] = capture_ms;
+        return failed;
+    }
+    out.result = std::move(measured->result);
+    out.result.timing_ms["capture"] = capture_ms;
+    if (!out.result.timing_ms.count("processing")) {
+        out.result.timing_ms["processing"] = MsSince(t_processing);
+    }
+    if (!measured->cloud.empty()) {
+        const auto ply = ctx.scratch_dir / "cloud.ply";
+        if (Status s = WritePly(ply, measured->cloud); s) {
+            out.files.cloud_ply = ply;
+        } else {
+            spdlog::warn("measurement {}: cloud not written: {}", ctx.id, s.error().message);
+        }
+    }
+    return out;
+}
+
+Result<json> DeviceStation::Calibrate(const JobContext& ctx, const BoxDimensions& reference) {
+    double capture_ms = 0.0;
+    Result<Session> session = Capture(ctx, capture_ms);
+    if (!session) return session.error();
+    const int poses = static_cast<int>(session->poses.size());
+    if (ctx.progress) ctx.progress(JobProgress{"calibration", poses, poses});
+    Result<CalibrationReport> report = CalibrateStation(*session, reference, CalibrationConfig{});
+    if (!report) return report.error();
+
+    json out = ToJson(*report);
+    out["calibrated_at"] = UtcTimestampNow();
+    out["reference_m"] = {reference.length_m, reference.width_m, reference.height_m};
+    // Durable before it is in force: written to a temporary file, then renamed over the old one.
+    const auto tmp = config_.calibration_file.string() + ".tmp";
+    {
+        std::ofstream file(tmp);
+        file << out.dump(2) << "\n";
+        if (!file) return Error{"STORAGE_ERROR", "cannot write " + tmp};
+    }
+    std::error_code ec;
+    std::filesystem::rename(tmp, config_.calibration_file, ec);
+    if (ec) return Error{"STORAGE_ERROR", "cannot write " + config_.calibration_file.string()};
+
+    std::lock_guard lock(devices_mutex_);
+    config_.station.calibration = report->calibration;
+    calibration_source_ = config_.calibration_file;
+    if (devices_) {
+        devices_->station.calibration = report->calibration;
+        devices_->calibrated = true;
+    }
+    return out;
+}
+
+void DeviceStation::RequestStop() {
+    std::lock_guard lock(devices_mutex_);
+    if (devices_ && devices_->turntable) devices_->turntable->RequestStop();
+}
+
+void DeviceStation::Shutdown() { CloseDevices(); }
+
+json DeviceStation::Devices() const {
+    std::lock_guard lock(devices_mutex_);
+    const bool ok = open_.load();
+    auto describe = [](const std::string& s) { return s.empty() ? json(nullptr) : json(s); };
+    json j;
+    j["turntable"] = {{"driver", config_.station.turntable.driver},
+                      {"description", describe(turntable_description_)},
+                      {"ok", ok}};
+    j["camera"] = {{"driver", config_.station.camera.driver},
+                   {"description", describe(camera_description_)},
+                   {"ok", ok}};
+    j["error"] = device_error_
+                     ? json{{"code", device_error_->code}, {"message", device_error_->message}}
+                     : json(nullptr);
+    return j;
+}
+
+json DeviceStation::Calibration() const {
+    json j;
+    std::lock_guard lock(devices_mutex_);
+    std::optional<StationCalibration> calibration = config_.station.calibration;
+    if (!calibration && devices_ && devices_->calibrated) {
+        calibration = devices_->station.calibration;
+    }
+    if (!calibration) {
+        j["calibrated"] = false;
+        j["age_s"] = nullptr;
+        return j;
+    }
+    j["calibrated"] = true;
+    j["table_center_m"] = Vec3(calibration->table_center_m);
+    j["table_axis"] = Vec3(calibration->table_axis);
+    j["depth_offset_m"] = calibration->depth_offset_m;
+    j["depth_scale"] = calibration->depth_scale;
+    j["source"] = calibration_source_.string();
+    // The calibration is as old as the file that carries it.
+    std::error_code ec;
+    const auto mtime = std::filesystem::last_write_time(calibration_source_, ec);
+    if (ec) {
+        j["age_s"] = nullptr;
+    } else {
+        const auto age = std::filesystem::file_time_type::clock::now() - mtime;
+        j["age_s"] = std::chrono::duration_cast<std::chrono::seconds>(age).count();
+    }
+    return j;
+}
+
+}  // namespace boxd

@@ -1,0 +1,407 @@
+// `boxd serve` as a real process on the simulated station (config/sim.yaml): real TCP sockets
+// (httplib::Client), a real SQLite data folder, real signals, and for the turntable a real
+// `boxd sim-turntable` whose registers the test reads over Modbus TCP with libmodbus.
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <modbus/modbus.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <chrono>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tests/support/run_command.h"
+#include "tests/support/temp_dir.h"
+
+namespace boxd {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
+
+const fs::path kSimConfig = fs::path(BOXD_SOURCE_DIR) / "config" / "sim.yaml";
+
+// Returns a TCP port that was free a moment ago on 127.0.0.1.
+int FreePort() {
+    const int fd = socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr));
+    socklen_t len = sizeof(addr);
+    getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+    close(fd);
+    return ntohs(addr.sin_port);
+}
+
+std::string ReadText(const fs::path& p) {
+    std::ifstream in(p);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+// A child process started with `argv` and `env` additions; stderr goes to `log`.
+class Process {
+public:
+    Process(const std::vector<std::string>& argv, const fs::path& log,
+            const std::vector<std::string>& env = {}) {
+        pid_ = fork();
+        if (pid_ == 0) {
+            const int err = open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+            const int null_fd = open("/dev/null", O_RDWR);
+            dup2(null_fd, 0);
+            dup2(null_fd, 1);
+            dup2(err, 2);
+            for (const auto& e : env) putenv(const_cast<char*>(e.c_str()));
+            std::vector<char*> args;
+            for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+            args.push_back(nullptr);
+            execv(args[0], args.data());
+            _exit(127);
+        }
+    }
+    ~Process() {
+        if (pid_ > 0 && !exited_) {
+            kill(pid_, SIGKILL);
+            waitpid(pid_, nullptr, 0);
+        }
+    }
+    pid_t pid() const { return pid_; }
+    void Signal(int sig) { kill(pid_, sig); }
+    // Returns the exit code (128 + signal when killed), or nullopt if still running at `timeout`.
+    std::optional<int> WaitExit(std::chrono::milliseconds timeout) {
+        const auto deadline = Clock::now() + timeout;
+        while (true) {
+            int status = 0;
+            if (waitpid(pid_, &status, WNOHANG) == pid_) {
+                exited_ = true;
+                return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+            }
+            if (Clock::now() > deadline) return std::nullopt;
+            std::this_thread::sleep_for(10ms);
+        }
+    }
+
+private:
+    pid_t pid_ = -1;
+    bool exited_ = false;
+};
+
+// A `boxd serve` process on `config` with its own port and data folder.
+class Daemon {
+public:
+    Daemon(const fs::path& config, const fs::path& data_dir, const fs::path& log,
+           const std::vector<std::string>& env = {})
+        : port_(FreePort()),
+          process_({BOXD_BINARY, "serve", "--config", config.string(), "--listen",
+                    "127.0.0.1:" + std::to_string(port_), "--data-dir", data_dir.string()},
+                   log, env),
+          client_("127.0.0.1", port_) {
+        client_.set_read_timeout(180, 0);
+        client_.set_connection_timeout(2, 0);
+    }
+    httplib::Client& client() { return client_; }
+    Process& process() { return process_; }
+    int port() const { return port_; }
+
+    // Returns true once GET /v1/health answers 200 (the daemon has opened its devices and
+    // announced readiness by then).
+    bool WaitHealthy(std::chrono::seconds timeout = 60s) {
+        const auto deadline = Clock::now() + timeout;
+        while (Clock::now() < deadline) {
+            if (auto res = client_.Get("/v1/health"); res && res->status == 200) return true;
+            if (process_.WaitExit(0ms)) return false;
+            std::this_thread::sleep_for(50ms);
+        }
+        return false;
+    }
+    json GetJson(const std::string& path) {
+        auto res = client_.Get(path);
+        if (!res) return json{{"transport_error", httplib::to_string(res.error())}};
+        return json::parse(res->body, nullptr, false);
+    }
+
+private:
+    int port_;
+    Process process_;
+    httplib::Client client_;
+};
+
+// Reads holding registers [addr, addr + n) of the Modbus TCP server on 127.0.0.1:port.
+std::optional<std::vector<uint16_t>> ReadRegisters(int port, int addr, int n) {
+    modbus_t* ctx = modbus_new_tcp("127.0.0.1", port);
+    if (!ctx) return std::nullopt;
+    std::optional<std::vector<uint16_t>> out;
+    if (modbus_connect(ctx) == 0) {
+        std::vector<uint16_t> regs(static_cast<std::size_t>(n));
+        if (modbus_read_registers(ctx, addr, n, regs.data()) == n) out = regs;
+    }
+    modbus_close(ctx);
+    modbus_free(ctx);
+    return out;
+}
+
+void WriteYaml(const YAML::Node& node, const fs::path& path) {
+    YAML::Emitter out;
+    out << node;
+    std::ofstream(path) << out.c_str() << "\n";
+}
+
+TEST(ServeConfig, BadValuesNameTheKeyAndExitWith2) {
+    test::TempDir dir;
+    const struct {
+        const char* section;
+        const char* key;
+        const char* value;
+        const char* expect;
+    } cases[] = {
+        {"server", "listen", "nowhere", "server.listen"},
+        {"server", "max_body_bytes", "12", "server.max_body_bytes"},
+        {"server", "colour", "blue", "server.colour"},
+        {"storage", "retention", "0", "storage.retention"},
+        {"storage", "keep_sessions", "maybe", "storage.keep_sessions"},
+        {"turntable", "driver", "carousel", "turntable.driver"},
+        {"capture", "frames_per_pose", "0", "capture.frames_per_pose"},
+    };
+    for (const auto& c : cases) {
+        YAML::Node root = YAML::LoadFile(kSimConfig.string());
+        root[c.section][c.key] = c.value;
+        const fs::path config = dir / "bad.yaml";
+        WriteYaml(root, config);
+        auto out = test::RunBoxd(
+            {"serve", "--config", config.string(), "--data-dir", (dir / "data").string()});
+        EXPECT_EQ(out.exit_code, 2) << c.expect << ": " << out.err;
+        EXPECT_NE(out.err.find(c.expect), std::string::npos) << out.err;
+        EXPECT_FALSE(fs::exists(dir / "data" / "boxd.db")) << c.expect;
+    }
+    auto missing = test::RunBoxd({"serve", "--config", (dir / "none.yaml").string()});
+    EXPECT_EQ(missing.exit_code, 2);
+    EXPECT_NE(missing.err.find("none.yaml"), std::string::npos) << missing.err;
+    auto bad_listen = test::RunBoxd({"serve", "--config", kSimConfig.string(), "--listen",
+                                     "127.0.0.1:99999", "--data-dir", (dir / "data").string()});
+    EXPECT_EQ(bad_listen.exit_code, 2);
+    EXPECT_NE(bad_listen.err.find("--listen"), std::string::npos) << bad_listen.err;
+}
+
+// The whole chain on config/sim.yaml: measure, read back, cloud, bad requests and a refused
+// second POST while busy; kill -9 mid-measurement; restart on the same data folder: the stored
+// measurement is served, the interrupted id is never reused, and history is newest first.
+TEST(ServeSimStation, MeasuresTheSimulatedBoxAndServesItAcrossKill9) {
+    test::TempDir dir;
+    const fs::path data = dir / "data";
+    const YAML::Node sim = YAML::LoadFile(kSimConfig.string());
+    const double true_l = sim["camera"]["simulated"]["box"]["length_m"].as<double>();
+    const double true_w = sim["camera"]["simulated"]["box"]["width_m"].as<double>();
+    const double true_h = sim["camera"]["simulated"]["box"]["height_m"].as<double>();
+    json first;
+    {
+        Daemon daemon(kSimConfig, data, dir / "serve1.log");
+        ASSERT_TRUE(daemon.WaitHealthy()) << ReadText(dir / "serve1.log");
+        auto& client = daemon.client();
+        EXPECT_EQ(daemon.GetJson("/v1/status")["state"], "idle") << ReadText(dir / "serve1.log");
+        auto none = client.Get("/v1/measurements/last");
+        ASSERT_TRUE(none);
+        EXPECT_EQ(none->status, 404);
+
+        auto res = client.Post("/v1/measure?wait=1", "", "application/json");
+        ASSERT_TRUE(res) << httplib::to_string(res.error());
+        ASSERT_EQ(res->status, 200) << res->body;
+        first = json::parse(res->body);
+        EXPECT_EQ(first["id"], "m-000001");
+        ASSERT_EQ(first["status"], "ok") << first.dump(2) << ReadText(dir / "serve1.log");
+        const json& d = first["dimensions"];
+        EXPECT_NEAR(d["length_m"].get<double>(), true_l, 0.015) << first.dump(2);
+        EXPECT_NEAR(d["width_m"].get<double>(), true_w, 0.015) << first.dump(2);
+        EXPECT_NEAR(d["height_m"].get<double>(), true_h, 0.015) << first.dump(2);
+        EXPECT_EQ(first["quality"]["poses"], sim["capture"]["poses"].as<int>());
+        EXPECT_GT(first["timing_ms"]["capture"].get<double>(), 0.0);
+
+        EXPECT_EQ(daemon.GetJson("/v1/measurements/last"), first);
+        EXPECT_EQ(daemon.GetJson("/v1/measurements/m-000001"), first);
+        auto cloud = client.Get("/v1/measurements/m-000001/cloud.ply");
+        ASSERT_TRUE(cloud);
+        EXPECT_EQ(cloud->status, 200);
+        EXPECT_EQ(cloud->body.rfind("ply", 0), 0u);
+        EXPECT_GT(cloud->body.size(), 1000u);
+
+        // Second measurement, started without waiting: a POST while it runs is refused; GETs
+        // and bad requests are answered meanwhile.
+        auto started = client.Post("/v1/measure", "", "application/json");
+        ASSERT_TRUE(started);
+        ASSERT_EQ(started->status, 202) << started->body;
+        EXPECT_EQ(json::parse(started->body)["id"], "m-000002");
+        auto busy = client.Post("/v1/measure?wait=1", "", "application/json");
+        ASSERT_TRUE(busy);
+        EXPECT_EQ(busy->status, 409);
+        EXPECT_EQ(json::parse(busy->body)["error"]["code"], "BUSY");
+        const json status = daemon.GetJson("/v1/status");
+        EXPECT_EQ(status["state"], "measuring") << status.dump();
+        EXPECT_EQ(status["measurement_id"], "m-000002") << status.dump();
+        auto malformed = client.Post("/v1/calibrate", "{\"reference_m\": [", "application/json");
+        ASSERT_TRUE(malformed);
+        EXPECT_EQ(malformed->status, 400);
+        auto unknown = client.Get("/v1/measurements/m-000001/nothing");
+        ASSERT_TRUE(unknown);
+        EXPECT_EQ(unknown->status, 404);
+        auto oversize = client.Post("/v1/measure", std::string(1 << 20, ' '), "application/json");
+        ASSERT_TRUE(oversize);
+        EXPECT_EQ(oversize->status, 413);
+        EXPECT_EQ(json::parse(oversize->body)["error"]["code"], "PAYLOAD_TOO_LARGE");
+        auto health = client.Get("/v1/health");
+        ASSERT_TRUE(health);
+        EXPECT_EQ(health->status, 200);
+
+        daemon.process().Signal(SIGKILL);  // mid-measurement
+        EXPECT_EQ(daemon.process().WaitExit(5s), 128 + SIGKILL);
+    }
+    {
+        Daemon again(kSimConfig, data, dir / "serve2.log");
+        ASSERT_TRUE(again.WaitHealthy()) << ReadText(dir / "serve2.log");
+        EXPECT_EQ(again.GetJson("/v1/measurements/last"), first);
+        EXPECT_EQ(again.GetJson("/v1/measurements/m-000002")["error"]["code"], "NOT_FOUND");
+        auto cloud = again.client().Get("/v1/measurements/m-000001/cloud.ply");
+        ASSERT_TRUE(cloud);
+        EXPECT_EQ(cloud->status, 200);
+        auto next = again.client().Post("/v1/measure", "", "application/json");
+        ASSERT_TRUE(next);
+        EXPECT_EQ(next->status, 202);
+        EXPECT_EQ(json::parse(next->body)["id"], "m-000003");  // m-000002 is not reused
+        again.process().Signal(SIGTERM);  // aborts m-000003, which is stored as failed
+        EXPECT_EQ(again.process().WaitExit(10s), 0) << ReadText(dir / "serve2.log");
+    }
+    Daemon third(kSimConfig, data, dir / "serve3.log");
+    ASSERT_TRUE(third.WaitHealthy()) << ReadText(dir / "serve3.log");
+    const json list = third.GetJson("/v1/measurements?limit=10")["measurements"];
+    ASSERT_EQ(list.size(), 2u) << list.dump();
+    EXPECT_EQ(list[0]["id"], "m-000003");
+    EXPECT_EQ(list[0]["status"], "failed");
+    EXPECT_EQ(list[1], first);
+    const json one = third.GetJson("/v1/measurements?limit=1")["measurements"];
+    ASSERT_EQ(one.size(), 1u);
+    EXPECT_EQ(one[0]["id"], "m-000003");
+}
+
+// SIGTERM mid-capture: the daemon exits cleanly within seconds and the drive is at rest — read
+// from the drive's own status register, over Modbus, after the daemon is gone.
+TEST(ServeSimStation, SigtermDuringAMeasurementStopsTheTableAndExitsCleanly) {
+    test::TempDir dir;
+    const fs::path port_file = dir / "sim.port";
+    Process sim({BOXD_BINARY, "sim-turntable", "--port", "0", "--port-file", port_file.string(),
+                 "--speed-dps", "15"},
+                dir / "sim.log");
+    int sim_port = 0;
+    for (int i = 0; i < 500 && sim_port == 0; ++i) {
+        std::ifstream(port_file) >> sim_port;
+        std::this_thread::sleep_for(10ms);
+    }
+    ASSERT_GT(sim_port, 0) << ReadText(dir / "sim.log");
+
+    // The simulated station, but with the turntable this test started: a slow one, so that the
+    // SIGTERM lands while it moves.
+    YAML::Node root = YAML::LoadFile(kSimConfig.string());
+    root["turntable"]["driver"] = "modbus-tcp";
+    root["turntable"]["host"] = "127.0.0.1";
+    root["turntable"]["port"] = sim_port;
+    root["turntable"]["speed_dps"] = 15;
+    const fs::path config = dir / "slow.yaml";
+    WriteYaml(root, config);
+
+    Daemon daemon(config, dir / "data", dir / "serve.log");
+    ASSERT_TRUE(daemon.WaitHealthy()) << ReadText(dir / "serve.log");
+    auto started = daemon.client().Post("/v1/measure", "", "application/json");
+    ASSERT_TRUE(started);
+    ASSERT_EQ(started->status, 202);
+    // Wait until the table is on its way to pose 1 (20 degrees at 15 deg/s: over a second).
+    bool moving = false;
+    for (int i = 0; i < 300 && !moving; ++i) {
+        auto status = ReadRegisters(sim_port, 10, 1);
+        const json s = daemon.GetJson("/v1/status");
+        moving = status && ((*status)[0] & 0x2) && s["progress"].is_object() &&
+                 s["progress"]["pose"].get<int>() >= 1;
+        std::this_thread::sleep_for(20ms);
+    }
+    ASSERT_TRUE(moving) << ReadText(dir / "serve.log");
+
+    const auto t0 = Clock::now();
+    daemon.process().Signal(SIGTERM);
+    const auto code = daemon.process().WaitExit(10s);
+    const double exit_s = std::chrono::duration<double>(Clock::now() - t0).count();
+    ASSERT_TRUE(code.has_value()) << "still running 10 s after SIGTERM";
+    EXPECT_EQ(*code, 0) << ReadText(dir / "serve.log");
+    EXPECT_LT(exit_s, 5.0);
+
+    auto regs = ReadRegisters(sim_port, 10, 1);
+    ASSERT_TRUE(regs);
+    EXPECT_EQ((*regs)[0] & 0x2, 0) << "status register 10 = " << (*regs)[0] << ": still moving";
+    auto angle1 = ReadRegisters(sim_port, 11, 2);
+    std::this_thread::sleep_for(300ms);
+    auto angle2 = ReadRegisters(sim_port, 11, 2);
+    ASSERT_TRUE(angle1 && angle2);
+    EXPECT_EQ(*angle1, *angle2) << "the table angle still changes";
+    auto stops = ReadRegisters(sim_port, 106, 1);
+    ASSERT_TRUE(stops);
+    EXPECT_GE((*stops)[0], 1) << "no stop command reached the drive";
+
+    // The aborted measurement was recorded as such.
+    Daemon again(config, dir / "data", dir / "serve2.log");
+    ASSERT_TRUE(again.WaitHealthy()) << ReadText(dir / "serve2.log");
+    const json aborted = again.GetJson("/v1/measurements/m-000001");
+    EXPECT_EQ(aborted["status"], "failed") << aborted.dump();
+    EXPECT_EQ(aborted["reason"]["code"], "ABORTED") << aborted.dump();
+    sim.Signal(SIGTERM);
+}
+
+// Under systemd: READY=1 once serving, WATCHDOG=1 from the loop's timer, STOPPING=1 on SIGTERM,
+// sent to a real AF_UNIX datagram socket given as NOTIFY_SOCKET.
+TEST(ServeSystemd, NotifiesReadyWatchdogAndStopping) {
+    test::TempDir dir;
+    const fs::path sock_path = dir / "notify";
+    const int fd = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+    sockaddr_un addr{};
+    addr.sun_family = AF_UNIX;
+    std::snprintf(addr.sun_path, sizeof(addr.sun_path), "%s", sock_path.c_str());
+    ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)), 0);
+    timeval tv{1, 0};
+    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+    std::vector<std::string> received;
+    auto receive_until = [&](const std::string& what, std::chrono::seconds timeout) {
+        const auto deadline = Clock::now() + timeout;
+        while (Clock::now() < deadline) {
+            char buf[4096];
+            const ssize_t n = recv(fd, buf, sizeof(buf), 0);
+            if (n <= 0) continue;
+            received.emplace_back(buf, static_cast<std::size_t>(n));
+            if (received.back().find(what) != std::string::npos) return true;
+        }
+        return false;
+    };
+
+    Daemon daemon(kSimConfig, dir / "data", dir / "serve.log",
+                  {"NOTIFY_SOCKET=" + sock_path.string(), "WATCHDOG_USEC=400000"});
+    EXPECT_TRUE(receive_until("READY=1", 60s)) << ReadText(dir / "serve.log");
+    // READY=1 comes after the API listens.
+    auto health = daemon.client().Get("/v1/health");
+    ASSERT_TRUE(health);
+    EXPECT_EQ(health->status, 200);
+    EXPECT_TRUE(receive_until("WATCHDOG=1", 3s));
+    EXPECT_TRUE(receive_until("WATCHDOG=1", 3s));  // and again, from the timer
+    daemon.process().Signal(SIGTERM);
+    EXPECT_TRUE(receive_until("STOPPING=1", 10s));
+    EXPECT_EQ(daemon.process().WaitExit(10s), 0) << ReadText(dir / "serve.log");
+    close(fd);
+}
+
+}  // namespace
+}  // namespace boxd
