@@ -1,0 +1,215 @@
+// `boxd calibrate` through the real binary on sessions written by `boxd synth`: the calibration
+// it prints and writes, its use for measuring other boxes captured with the same station, and
+// its refusals (exit 2 with a one-line error naming the problem).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "pipeline/synthetic_station.h"
+#include "tests/support/run_command.h"
+#include "tests/support/temp_dir.h"
+
+namespace boxd {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using test::RunBoxd;
+
+// One station: the same seed gives the same injected calibration errors and sensor bias.
+constexpr std::uint64_t kSeed = 21;
+constexpr double kCenterError = 0.015, kAxisErrorDeg = 1.5, kDepthOffset = 0.010;
+
+std::vector<std::string> Synth(const fs::path& out, const std::vector<std::string>& dims,
+                               std::vector<std::string> extra = {}) {
+    std::vector<std::string> args = {"synth",
+                                     "--out",
+                                     out.string(),
+                                     "--dims",
+                                     dims[0],
+                                     dims[1],
+                                     dims[2],
+                                     "--poses",
+                                     "12",
+                                     "--frames",
+                                     "2",
+                                     "--seed",
+                                     std::to_string(kSeed),
+                                     "--calib-center-error-m",
+                                     std::to_string(kCenterError),
+                                     "--calib-axis-error-deg",
+                                     std::to_string(kAxisErrorDeg),
+                                     "--depth-offset-m",
+                                     std::to_string(kDepthOffset)};
+    args.insert(args.end(), extra.begin(), extra.end());
+    return args;
+}
+
+StationCalibration TrueCalibration() {
+    SyntheticStationConfig c;
+    c.seed = kSeed;
+    c.calib_center_error_m = kCenterError;
+    c.calib_axis_error_deg = kAxisErrorDeg;
+    c.true_depth_offset_m = kDepthOffset;
+    return MakeSyntheticScene(c).true_calibration;
+}
+
+Eigen::Vector3d Vec(const json& j) {
+    return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
+}
+
+json ReadJson(const fs::path& p) {
+    std::ifstream in(p);
+    return json::parse(in);
+}
+
+void WriteJson(const fs::path& p, const json& j) {
+    std::ofstream out(p);
+    out << j.dump(2);
+}
+
+// Returns the measured (length, width, height) of `session`, or an empty vector on no_dim.
+std::vector<double> Measure(const fs::path& session) {
+    const auto r = RunBoxd({"measure", "--session", session.string()});
+    const json j = json::parse(r.out);
+    if (r.exit_code != 0) return {};
+    const json& d = j.at("dimensions");
+    return {d.at("length_m").get<double>(), d.at("width_m").get<double>(),
+            d.at("height_m").get<double>()};
+}
+
+double MaxError(const std::vector<double>& got, const std::vector<double>& want) {
+    if (got.size() != 3) return 1.0;
+    double e = 0.0;
+    for (std::size_t i = 0; i < 3; ++i) e = std::max(e, std::abs(got[i] - want[i]));
+    return e;
+}
+
+TEST(CliCalibrate, CalibratesAndTheCalibrationMakesOtherBoxesMeasureRight) {
+    test::TempDir dir;
+    const fs::path ref = dir / "reference";
+    ASSERT_EQ(
+        RunBoxd(Synth(ref, {"0.32", "0.26", "0.30"}, {"--offset", "0.05", "0.02", "--yaw", "-20"}))
+            .exit_code,
+        0);
+    const fs::path file = dir / "calibration.yaml";
+    const auto r = RunBoxd({"calibrate", "--session", ref.string(), "--reference", "0.32", "0.26",
+                            "0.30", "--out", file.string()});
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const json out = json::parse(r.out);
+    const json& cal = out.at("calibration");
+    const StationCalibration truth = TrueCalibration();
+    const Eigen::Vector3d center = Vec(cal.at("table_center_m"));
+    const Eigen::Vector3d axis = Vec(cal.at("table_axis"));
+    EXPECT_LT((center - truth.table_center_m).norm(), 0.001);
+    EXPECT_LT(std::acos(std::min(1.0, axis.dot(truth.table_axis))) * 180.0 / M_PI, 0.1);
+    EXPECT_NEAR(cal.at("depth_offset_m").get<double>(), kDepthOffset, 0.002);
+    EXPECT_DOUBLE_EQ(cal.at("depth_scale").get<double>(), 1.0);
+    EXPECT_EQ(out.at("quality").at("poses_used"), 12);
+    EXPECT_GT(out.at("uncertainty").at("depth_offset_m").get<double>(), 0.0);
+    EXPECT_TRUE(out.at("uncertainty").at("depth_scale").is_null());
+
+    // The file holds the same numbers in a `calibration:` section (YAML).
+    std::ifstream in(file);
+    const std::string yaml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(yaml.find("\ncalibration:\n  table_center_m: ["), std::string::npos) << yaml;
+    EXPECT_NE(yaml.find("depth_offset_m: "), std::string::npos) << yaml;
+
+    // Another box captured at the same station: measured with the calibration it meets +-3 mm;
+    // with the recorded (uncalibrated) values it does not.
+    const fs::path other = dir / "other";
+    ASSERT_EQ(RunBoxd(Synth(other, {"0.45", "0.33", "0.40"})).exit_code, 0);
+    const std::vector<double> truth_dims = {0.45, 0.33, 0.40};
+    const std::vector<double> before = Measure(other);
+    json session = ReadJson(other / "session.json");
+    session["calibration"] = cal;
+    WriteJson(other / "session.json", session);
+    const std::vector<double> after = Measure(other);
+    std::printf("other box: max error %.2f mm uncalibrated, %.2f mm calibrated\n",
+                MaxError(before, truth_dims) * 1e3, MaxError(after, truth_dims) * 1e3);
+    EXPECT_LE(MaxError(after, truth_dims), 0.003);
+    // The uncalibrated figure is printed, not asserted: with these injected errors the current
+    // measurement pipeline (table refit, pose-graph centre) absorbs them and still meets 3 mm
+    // (or refuses).
+}
+
+TEST(CliCalibrate, RefusesTooFewPoses) {
+    test::TempDir dir;
+    ASSERT_EQ(RunBoxd({"synth", "--out", (dir / "s").string(), "--dims", "0.3", "0.3", "0.3",
+                       "--poses", "3", "--frames", "1"})
+                  .exit_code,
+              0);
+    const auto r = RunBoxd(
+        {"calibrate", "--session", (dir / "s").string(), "--reference", "0.3", "0.3", "0.3"});
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("TOO_FEW_POSES"), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty());
+}
+
+TEST(CliCalibrate, RefusesAWrongReferenceBox) {
+    test::TempDir dir;
+    ASSERT_EQ(RunBoxd({"synth", "--out", (dir / "s").string(), "--dims", "0.3", "0.25", "0.3",
+                       "--poses", "8", "--frames", "1"})
+                  .exit_code,
+              0);
+    const auto r = RunBoxd(
+        {"calibrate", "--session", (dir / "s").string(), "--reference", "0.4", "0.25", "0.3"});
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("WRONG_REFERENCE"), std::string::npos) << r.err;
+}
+
+TEST(CliCalibrate, RefusesWhenTheBoxMoved) {
+    test::TempDir dir;
+    ASSERT_EQ(
+        RunBoxd({"synth", "--out", (dir / "s").string(), "--dims", "0.3", "0.25", "0.3", "--poses",
+                 "8", "--frames", "1", "--move-at-pose", "4", "--move-by", "0.05", "0.0", "10"})
+            .exit_code,
+        0);
+    const auto r = RunBoxd(
+        {"calibrate", "--session", (dir / "s").string(), "--reference", "0.3", "0.25", "0.3"});
+    EXPECT_EQ(r.exit_code, 2);
+    // A box pushed mid-session smears the fused cloud; the refusal is BOX_MOVED when the views'
+    // disagreement is caught, WRONG_REFERENCE when the smeared box no longer has the stated size.
+    EXPECT_TRUE(r.err.find("BOX_MOVED") != std::string::npos ||
+                r.err.find("WRONG_REFERENCE") != std::string::npos)
+        << r.err;
+}
+
+TEST(CliCalibrate, RefusesWhenTheTableIsNotVisible) {
+    test::TempDir dir;
+    const fs::path s = dir / "s";
+    ASSERT_EQ(RunBoxd({"synth", "--out", s.string(), "--dims", "0.3", "0.25", "0.3", "--poses", "4",
+                       "--frames", "1"})
+                  .exit_code,
+              0);
+    // Blank frames, as from a covered lens or a camera pointed away from the table.
+    const cv::Mat blank = cv::Mat::zeros(480, 640, CV_16UC1);
+    const json session = ReadJson(s / "session.json");
+    for (const json& pose : session.at("poses")) {
+        for (const json& frame : pose.at("frames")) {
+            ASSERT_TRUE(cv::imwrite((s / frame.get<std::string>()).string(), blank));
+        }
+    }
+    const auto r =
+        RunBoxd({"calibrate", "--session", s.string(), "--reference", "0.3", "0.25", "0.3"});
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("TABLE_NOT_VISIBLE"), std::string::npos) << r.err;
+}
+
+TEST(CliCalibrate, RejectsABadReferenceArgument) {
+    const auto r = RunBoxd({"calibrate", "--session", "/nonexistent", "--reference", "0.3", "0.3"});
+    EXPECT_NE(r.exit_code, 0);
+    const auto r2 =
+        RunBoxd({"calibrate", "--session", "/nonexistent", "--reference", "0.3", "0.3", "0.3"});
+    EXPECT_EQ(r2.exit_code, 2);
+    EXPECT_NE(r2.err.find("/nonexistent"), std::string::npos) << r2.err;
+}
+
+}  // namespace
+}  // namespace boxd
