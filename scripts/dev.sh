@@ -44,12 +44,25 @@ build() {
 }
 
 demo() {
-    local out
+    # The daemon on the simulated station (config/sim.yaml: a sim-turntable child process driven
+    # over Modbus TCP, the simulated camera), then one measurement through the REST API.
+    local out port
     out=$(mktemp -d /tmp/boxd-demo.XXXXXX)
-    echo "dev.sh: rendering a 0.455 x 0.330 x 0.460 m box on the simulated station into $out"
-    "$BUILD_DIR/daemon/boxd" synth --out "$out/session" --dims 0.455 0.33 0.46 --poses 18 --frames 4
-    echo "dev.sh: measuring it"
-    "$BUILD_DIR/daemon/boxd" measure --session "$out/session"
+    port=${BOXD_DEMO_PORT:-8080}
+    echo "dev.sh: starting boxd serve on 127.0.0.1:$port (simulated station, data in $out)"
+    "$BUILD_DIR/daemon/boxd" serve --config config/sim.yaml --listen "127.0.0.1:$port" \
+        --data-dir "$out" 2> "$out/boxd.log" &
+    DEMO_PID=$!
+    trap 'kill -TERM "$DEMO_PID" 2>/dev/null; wait "$DEMO_PID" 2>/dev/null || true' EXIT
+    for _ in $(seq 1 150); do
+        curl -sf "http://127.0.0.1:$port/v1/health" > /dev/null && break
+        kill -0 "$DEMO_PID" 2>/dev/null || { cat "$out/boxd.log" >&2; exit 1; }
+        sleep 0.2
+    done
+    echo "dev.sh: POST /v1/measure?wait=1 (the simulated box is 0.455 x 0.330 x 0.460 m)"
+    curl -sS -X POST "http://127.0.0.1:$port/v1/measure?wait=1"
+    echo
+    echo "dev.sh: the daemon's log is $out/boxd.log"
 }
 
 run_tests() {
