@@ -77,8 +77,8 @@ Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, doubl
                 ++kept;
             }
         }
-        // Too many disagreeing readings: the pixel is unstable (an edge or a moving surface).
-        if (kept < required || 2 * kept < k) continue;
+        // No strict majority agrees: the pixel is unstable (an edge or a moving surface).
+        if (kept < required || 2 * kept <= k) continue;
         out.z_m[i] = static_cast<float>(sum / static_cast<double>(kept));
     }
     return out;

@@ -65,6 +65,9 @@ Status RefusalConfig::Validate() const {
     if (max_outside_points < 0) return bad("max_outside_points", "must be >= 0");
     if (!(min_dimension_m > 0.0)) return bad("min_dimension_m", "must be > 0");
     if (!(max_registration_rmse_m > 0.0)) return bad("max_registration_rmse_m", "must be > 0");
+    if (!(max_rejected_edge_fraction >= 0.0 && max_rejected_edge_fraction <= 1.0)) {
+        return bad("max_rejected_edge_fraction", "must be in [0, 1]");
+    }
     if (!(max_unconstrained_fraction >= 0.0 && max_unconstrained_fraction <= 1.0)) {
         return bad("max_unconstrained_fraction", "must be in [0, 1]");
     }
@@ -203,6 +206,15 @@ Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig
                     Fmt("%.1f deg, %.1f mm", report->max_model_yaw_deviation_rad * 180.0 / M_PI,
                         report->max_model_translation_deviation_m * 1000.0) +
                     "): the object moved on the table");
+        }
+        const int graph_edges = report->rejected_edges + report->active_edges;
+        if (graph_edges > 0 &&
+            report->rejected_edges > refuse.max_rejected_edge_fraction * graph_edges) {
+            return run.Refuse(reason::kObjectMoved,
+                              std::to_string(report->rejected_edges) + " of " +
+                                  std::to_string(graph_edges) +
+                                  " view alignments disagree with the others: the object moved "
+                                  "on the table");
         }
         if (report->active_edges == 0 ||
             report->unconstrained_nodes > refuse.max_unconstrained_fraction * n) {

@@ -28,6 +28,9 @@ struct RefusalConfig {
     double min_dimension_m = 0.03;  // a smaller side: OBJECT_TOO_SMALL
     double max_registration_rmse_m = 0.004;    // mean ICP RMSE of the kept edges
     double max_unconstrained_fraction = 0.25;  // views without any kept edge
+    // More alignments than this fraction disagreeing with the rest: the views show the object
+    // in two places (it moved), and no single size describes them.
+    double max_rejected_edge_fraction = 0.2;
     double max_model_yaw_deviation_deg = 3.0;  // registered poses vs the turntable model ...
     double max_model_translation_deviation_m = 0.015;  // ... beyond these: OBJECT_MOVED
 

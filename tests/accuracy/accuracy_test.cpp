@@ -1,0 +1,139 @@
+// The accuracy suite: every case of cases.json is rendered with `boxd synth` and measured with
+// `boxd measure` through the real binary; each dimension must be within the case's tolerance.
+// Prints a report table with the error per case and the worst error per dimension.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "tests/support/run_command.h"
+#include "tests/support/temp_dir.h"
+
+namespace boxd {
+namespace {
+
+using nlohmann::json;
+
+struct Outcome {
+    std::string name;
+    std::string status;
+    std::string reason;
+    double tol = 0.0;
+    double err[3] = {NAN, NAN, NAN};  // length, width, height (measured - true), metres
+    double processing_ms = 0.0;
+};
+
+std::vector<std::string> SynthArgs(const json& c, const std::string& out) {
+    auto num = [](double v) {
+        char b[32];
+        std::snprintf(b, sizeof(b), "%.6g", v);
+        return std::string(b);
+    };
+    std::vector<std::string> a{"synth", "--out", out, "--dims"};
+    for (const auto& d : c["dims"]) a.push_back(num(d.get<double>()));
+    a.insert(a.end(), {"--noise", c["noise"].get<std::string>(), "--poses",
+                       std::to_string(c["poses"].get<int>()), "--frames",
+                       std::to_string(c["frames"].get<int>()), "--seed",
+                       std::to_string(c["seed"].get<int>())});
+    if (c.contains("offset")) {
+        a.insert(a.end(), {"--offset", num(c["offset"][0].get<double>()),
+                           num(c["offset"][1].get<double>())});
+    }
+    const std::pair<const char*, const char*> scalars[] = {
+        {"yaw", "--yaw"},
+        {"distance", "--distance"},
+        {"elevation", "--elevation"},
+        {"aim_height", "--aim-height"},
+        {"calib_center_error_m", "--calib-center-error-m"},
+        {"calib_axis_error_deg", "--calib-axis-error-deg"}};
+    for (const auto& [key, flag] : scalars) {
+        if (c.contains(key)) a.insert(a.end(), {flag, num(c[key].get<double>())});
+    }
+    return a;
+}
+
+Outcome RunCase(const json& c) {
+    Outcome o;
+    o.name = c["name"].get<std::string>();
+    o.tol = c["tol_m"].get<double>();
+    test::TempDir dir;
+    const std::string session = (dir / "session").string();
+    const auto synth = test::RunBoxd(SynthArgs(c, session));
+    if (synth.exit_code != 0) {
+        o.status = "synth failed";
+        o.reason = synth.err;
+        return o;
+    }
+    const auto r = test::RunBoxd({"measure", "--session", session});
+    json j;
+    try {
+        j = json::parse(r.out);
+    } catch (const std::exception&) {
+        o.status = "exit " + std::to_string(r.exit_code);
+        o.reason = r.err;
+        return o;
+    }
+    o.status = j["status"].get<std::string>();
+    if (j["reason"].is_object()) o.reason = j["reason"]["code"].get<std::string>();
+    if (j["timing_ms"].contains("processing")) {
+        o.processing_ms = j["timing_ms"]["processing"].get<double>();
+    }
+    if (o.status == "ok" && r.exit_code == 0) {
+        const char* keys[3] = {"length_m", "width_m", "height_m"};
+        std::vector<double> truth;
+        for (const auto& d : c["dims"]) truth.push_back(d.get<double>());
+        std::sort(truth.begin(), truth.begin() + 2, std::greater<>());
+        for (int k = 0; k < 3; ++k) {
+            o.err[k] = j["dimensions"][keys[k]].get<double>() - truth[static_cast<std::size_t>(k)];
+        }
+    }
+    return o;
+}
+
+TEST(Accuracy, SyntheticSuiteWithinTolerance) {
+    std::ifstream in(std::string(BOXD_SOURCE_DIR) + "/tests/accuracy/cases.json");
+    ASSERT_TRUE(in) << "tests/accuracy/cases.json not found";
+    const json cases = json::parse(in)["cases"];
+    ASSERT_GE(cases.size(), 12u);
+    std::vector<Outcome> outcomes(cases.size());
+    // Two cases at a time: the CI machine has two cores.
+    std::vector<std::thread> workers;
+    for (int w = 0; w < 2; ++w) {
+        workers.emplace_back([&, w] {
+            for (std::size_t i = static_cast<std::size_t>(w); i < cases.size(); i += 2) {
+                outcomes[i] = RunCase(cases[i]);
+            }
+        });
+    }
+    for (auto& t : workers) t.join();
+
+    double worst[3] = {0.0, 0.0, 0.0};
+    std::printf("\n%-24s %-8s %9s %9s %9s %7s %9s\n", "case", "status", "dL mm", "dW mm", "dH mm",
+                "tol mm", "proc ms");
+    for (const Outcome& o : outcomes) {
+        std::printf("%-24s %-8s %9.2f %9.2f %9.2f %7.1f %9.0f %s\n", o.name.c_str(),
+                    o.status.c_str(), o.err[0] * 1000, o.err[1] * 1000, o.err[2] * 1000,
+                    o.tol * 1000, o.processing_ms, o.reason.c_str());
+        for (int k = 0; k < 3; ++k) {
+            if (std::isfinite(o.err[k])) worst[k] = std::max(worst[k], std::abs(o.err[k]));
+        }
+    }
+    std::printf("%-24s %-8s %9.2f %9.2f %9.2f\n\n", "worst |error|", "", worst[0] * 1000,
+                worst[1] * 1000, worst[2] * 1000);
+    for (const Outcome& o : outcomes) {
+        EXPECT_EQ(o.status, "ok") << o.name << ": " << o.reason;
+        for (int k = 0; k < 3; ++k) {
+            EXPECT_LE(std::abs(o.err[k]), o.tol) << o.name << " dimension " << k;
+        }
+    }
+}
+
+}  // namespace
+}  // namespace boxd

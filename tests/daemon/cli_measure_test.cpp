@@ -1,0 +1,128 @@
+// boxd measure through the real binary: exit codes, the JSON contract, --cloud and the refusals.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "tests/support/run_command.h"
+#include "tests/support/temp_dir.h"
+
+namespace boxd {
+namespace {
+
+using nlohmann::json;
+using test::RunBoxd;
+using test::TempDir;
+
+// Renders a small, quick session (12 poses, 2 frames) with extra synth arguments.
+std::filesystem::path Synth(const TempDir& dir, const std::string& name,
+                            std::vector<std::string> args) {
+    const auto out = dir / name;
+    std::vector<std::string> argv{"synth", "--out", out.string(), "--poses", "12", "--frames", "2"};
+    argv.insert(argv.end(), args.begin(), args.end());
+    const auto r = RunBoxd(argv);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return out;
+}
+
+json Measure(const std::filesystem::path& session, int expected_exit,
+             std::vector<std::string> extra = {}) {
+    std::vector<std::string> argv{"measure", "--session", session.string()};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    const auto r = RunBoxd(argv);
+    EXPECT_EQ(r.exit_code, expected_exit) << r.out << r.err;
+    return json::parse(r.out);
+}
+
+TEST(CliMeasure, MeasuresABoxAndWritesTheCloud) {
+    TempDir dir;
+    const auto s = Synth(dir, "box", {"--dims", "0.30", "0.20", "0.15", "--seed", "3"});
+    const auto ply = dir / "cloud.ply";
+    const json j = Measure(s, 0, {"--cloud", ply.string()});
+    EXPECT_EQ(j["status"], "ok");
+    EXPECT_TRUE(j["reason"].is_null());
+    EXPECT_NEAR(j["dimensions"]["length_m"].get<double>(), 0.30, 0.003);
+    EXPECT_NEAR(j["dimensions"]["width_m"].get<double>(), 0.20, 0.003);
+    EXPECT_NEAR(j["dimensions"]["height_m"].get<double>(), 0.15, 0.003);
+    EXPECT_EQ(j["dimensions"]["method"], "footprint");
+    EXPECT_EQ(j["obb"]["method"], "pca");
+    EXPECT_EQ(j["obb"]["frame"], "table");
+    EXPECT_EQ(j["quality"]["poses"], 12);
+    EXPECT_GT(j["quality"]["points"].get<long>(), 1000);
+    for (const char* stage :
+         {"capture", "preprocess", "registration", "optimization", "fusion", "fit", "processing"}) {
+        EXPECT_TRUE(j["timing_ms"].contains(stage)) << stage;
+    }
+    std::ifstream in(ply, std::ios::binary);
+    std::string header;
+    std::getline(in, header);
+    EXPECT_EQ(header, "ply");
+    EXPECT_GT(std::filesystem::file_size(ply), 1000u);
+
+    // The same session measures to the same numbers every time (determinism).
+    const json again = Measure(s, 0, {"--cloud", ply.string()});
+    EXPECT_EQ(again["dimensions"], j["dimensions"]);
+    EXPECT_EQ(again["obb"], j["obb"]);
+
+    const json pca = Measure(s, 0, {"--method", "pca"});
+    EXPECT_EQ(pca["dimensions"]["method"], "pca");
+    EXPECT_EQ(pca["obb"], j["obb"]);
+}
+
+TEST(CliMeasure, InvalidSessionIsBadInput) {
+    TempDir dir;
+    const auto r = RunBoxd({"measure", "--session", (dir / "missing").string()});
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_TRUE(r.out.empty());
+    EXPECT_NE(r.err.find("error"), std::string::npos);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1);
+    EXPECT_EQ(
+        RunBoxd({"measure", "--session", dir.path().string(), "--method", "median"}).exit_code, 2);
+}
+
+TEST(CliMeasure, EmptyTableIsNoObject) {
+    TempDir dir;
+    // A 2 mm sheet lies below the segmentation height: the table is empty for the pipeline.
+    const auto s = Synth(dir, "empty", {"--dims", "0.2", "0.2", "0.002"});
+    const json j = Measure(s, 3);
+    EXPECT_EQ(j["status"], "no_dim");
+    EXPECT_EQ(j["reason"]["code"], "NO_OBJECT");
+    EXPECT_TRUE(j["dimensions"].is_null());
+}
+
+TEST(CliMeasure, BoxLeavingTheViewIsTooLarge) {
+    TempDir dir;
+    const auto s = Synth(dir, "large", {"--dims", "0.55", "0.5", "0.5", "--distance", "0.7"});
+    const json j = Measure(s, 3);
+    EXPECT_EQ(j["reason"]["code"], "OBJECT_TOO_LARGE");
+    EXPECT_TRUE(j["dimensions"].is_null());
+}
+
+TEST(CliMeasure, AllZeroFramesAreInsufficientData) {
+    TempDir dir;
+    const auto s = Synth(dir, "zeros", {"--dims", "0.3", "0.2", "0.15"});
+    // Pose 4's frames come back without a single reading (a camera that delivered nothing).
+    const cv::Mat zeros = cv::Mat::zeros(480, 640, CV_16UC1);
+    for (const auto& f : std::filesystem::directory_iterator(s / "pose_004")) {
+        ASSERT_TRUE(cv::imwrite(f.path().string(), zeros));
+    }
+    const json j = Measure(s, 3);
+    EXPECT_EQ(j["reason"]["code"], "INSUFFICIENT_DATA");
+}
+
+TEST(CliMeasure, MovedBoxIsObjectMoved) {
+    TempDir dir;
+    const auto s = Synth(
+        dir, "moved",
+        {"--dims", "0.3", "0.2", "0.15", "--move-at-pose", "6", "--move-by", "0.05", "0.0", "10"});
+    const json j = Measure(s, 3);
+    EXPECT_EQ(j["reason"]["code"], "OBJECT_MOVED");
+    EXPECT_TRUE(j["dimensions"].is_null());
+}
+
+}  // namespace
+}  // namespace boxd

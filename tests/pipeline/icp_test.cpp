@@ -1,0 +1,80 @@
+#include "pipeline/icp.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/LU>
+#include <cmath>
+#include <random>
+
+#include "pipeline/registration_cloud.h"
+
+namespace boxd {
+namespace {
+
+// Two visible sides and the top of a box, as one view sees it, with optional noise.
+Points BoxView(double sigma, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> n(0.0, sigma);
+    Points pts;
+    const double l = 0.3, w = 0.2, h = 0.15, step = 0.003;
+    for (double z = 0.01; z < h; z += step) {
+        for (double v = -w / 2; v <= w / 2; v += step) pts.emplace_back(l / 2 + n(rng), v, z);
+        for (double u = -l / 2; u <= l / 2; u += step) pts.emplace_back(u, w / 2 + n(rng), z);
+    }
+    for (double u = -l / 2; u <= l / 2; u += step) {
+        for (double v = -w / 2; v <= w / 2; v += step) pts.emplace_back(u, v, h + n(rng));
+    }
+    return pts;
+}
+
+Points Move(const Points& pts, const Se2& t) {
+    Points out;
+    for (const auto& p : pts) out.push_back(t.Apply(p));
+    return out;
+}
+
+TEST(AlignIcp, RecoversKnownPlanarMotionCoarseThenFine) {
+    const RegistrationCloudConfig cloud_cfg;
+    const Points target_pts = BoxView(0.0005, 1);
+    const Se2 truth{0.012, -0.008, 3.0 * M_PI / 180.0};
+    // The source is the same scene seen after the inverse motion: truth maps it back.
+    const Points source_pts = Move(BoxView(0.0005, 2), truth.Inverse());
+    IcpTarget target(BuildRegistrationCloud(target_pts, cloud_cfg));
+    const OrientedPoints source = BuildRegistrationCloud(source_pts, cloud_cfg);
+    IcpConfig coarse;
+    coarse.max_correspondence_m = 0.03;
+    const IcpResult c = AlignIcp(source, target, Se2{}, coarse);
+    IcpConfig fine;
+    fine.max_correspondence_m = 0.006;
+    const IcpResult f = AlignIcp(source, target, c.transform, fine);
+    EXPECT_TRUE(f.converged);
+    EXPECT_NEAR(f.transform.x, truth.x, 0.0005);
+    EXPECT_NEAR(f.transform.y, truth.y, 0.0005);
+    EXPECT_NEAR(f.transform.yaw, truth.yaw, 0.1 * M_PI / 180.0);
+    EXPECT_GT(f.fitness, 0.9);
+    EXPECT_LT(f.rmse, 0.002);
+    // The information is symmetric positive definite.
+    EXPECT_TRUE(f.information.isApprox(f.information.transpose()));
+    EXPECT_GT(f.information.determinant(), 0.0);
+}
+
+TEST(AlignIcp, ReportsNoOverlap) {
+    const RegistrationCloudConfig cloud_cfg;
+    const Points pts = BoxView(0.0, 3);
+    IcpTarget target(BuildRegistrationCloud(pts, cloud_cfg));
+    const OrientedPoints far = BuildRegistrationCloud(Move(pts, Se2{1.0, 0.0, 0.0}), cloud_cfg);
+    const IcpResult r = AlignIcp(far, target, Se2{}, IcpConfig{});
+    EXPECT_FALSE(r.converged);
+    EXPECT_EQ(r.fitness, 0.0);
+}
+
+TEST(IcpConfig, ValidateNamesField) {
+    IcpConfig c;
+    c.max_correspondence_m = -1.0;
+    const Status s = c.Validate("registration.fine");
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.error().message.find("registration.fine.max_correspondence_m"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace boxd
