@@ -32,8 +32,8 @@ Session SmallSession() {
             for (std::size_t i = 0; i < img.pixels.size(); ++i) {
                 img.pixels[i] = static_cast<std::uint16_t>(800 + 13 * p + 7 * f + i);
             }
-            img.pixels[5] = 0;       // no reading
-            img.pixels[6] = 65535;   // full 16-bit range survives
+            img.pixels[5] = 0;      // no reading
+            img.pixels[6] = 65535;  // full 16-bit range survives
             pose.frames.push_back(img);
         }
         s.poses.push_back(pose);
@@ -102,14 +102,15 @@ TEST(SessionIo, RejectsMissingRequiredKeys) {
         const char* key;
         const char* field;
     };
-    for (const Case& c : {Case{"", "format", "format"}, Case{"", "camera", "camera"},
-                          Case{"camera", "fx", "camera.fx"}, Case{"camera", "width", "camera.width"},
-                          Case{"camera", "depth_unit_m", "camera.depth_unit_m"},
-                          Case{"", "calibration", "calibration"},
-                          Case{"calibration", "table_axis", "calibration.table_axis"},
-                          Case{"calibration", "table_center_m", "calibration.table_center_m"},
-                          Case{"calibration", "depth_offset_m", "calibration.depth_offset_m"},
-                          Case{"", "turntable", "turntable"}, Case{"", "poses", "poses"}}) {
+    for (const Case& c :
+         {Case{"", "format", "format"}, Case{"", "camera", "camera"},
+          Case{"camera", "fx", "camera.fx"}, Case{"camera", "width", "camera.width"},
+          Case{"camera", "depth_unit_m", "camera.depth_unit_m"},
+          Case{"", "calibration", "calibration"},
+          Case{"calibration", "table_axis", "calibration.table_axis"},
+          Case{"calibration", "table_center_m", "calibration.table_center_m"},
+          Case{"calibration", "depth_offset_m", "calibration.depth_offset_m"},
+          Case{"", "turntable", "turntable"}, Case{"", "poses", "poses"}}) {
         auto msg = LoadError([&](json& j, const fs::path&) {
             if (std::string(c.parent).empty()) {
                 j.erase(c.key);
@@ -168,9 +169,8 @@ TEST(SessionIo, RejectsNonUnitAxis) {
 }
 
 TEST(SessionIo, RejectsPathsLeavingTheFolder) {
-    auto msg = LoadError([](json& j, const fs::path&) {
-        j["poses"][0]["frames"][1] = "/etc/passwd";
-    });
+    auto msg =
+        LoadError([](json& j, const fs::path&) { j["poses"][0]["frames"][1] = "/etc/passwd"; });
     EXPECT_MENTIONS(msg, "poses[0].frames[1]");
     msg = LoadError([](json& j, const fs::path&) {
         j["poses"][2]["frames"][0] = "pose_002/../../other/frame_00.png";
@@ -198,9 +198,8 @@ TEST(SessionIo, RejectsEightBitImage) {
 }
 
 TEST(SessionIo, RejectsMissingOrCorruptFrameFile) {
-    auto msg = LoadError([](json&, const fs::path& dir) {
-        fs::remove(dir / "pose_002/frame_01.png");
-    });
+    auto msg =
+        LoadError([](json&, const fs::path& dir) { fs::remove(dir / "pose_002/frame_01.png"); });
     EXPECT_MENTIONS(msg, "pose_002/frame_01.png");
     msg = LoadError([](json&, const fs::path& dir) {
         std::ofstream(dir / "pose_001/frame_01.png") << "not a png";
