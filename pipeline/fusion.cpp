@@ -6,19 +6,6 @@
 
 namespace boxd {
 
-namespace {
-
-std::uint64_t CellKey(const Eigen::Vector3f& p, float inv) {
-    auto q = [inv](float v) {
-        return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v * inv)) +
-                                          (1 << 20)) &
-               0x1FFFFF;
-    };
-    return (q(p.x()) << 42) | (q(p.y()) << 21) | q(p.z());
-}
-
-}  // namespace
-
 Status FusionConfig::Validate() const {
     auto bad = [](const std::string& f, const std::string& why) -> Status {
         return Error{"INVALID_CONFIG", "fusion." + f + ": " + why};
@@ -53,7 +40,7 @@ FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& p
     std::unordered_map<std::uint64_t, int> counts;
     counts.reserve(all.points.size() / 4 + 16);
     for (std::size_t i = 0; i < all.points.size(); ++i) {
-        keys[i] = CellKey(all.points[i], inv);
+        keys[i] = VoxelKey(all.points[i], inv);
         ++counts[keys[i]];
     }
     FusedCloud out;

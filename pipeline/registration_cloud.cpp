@@ -12,20 +12,6 @@
 
 namespace boxd {
 
-namespace {
-
-// 21 bits per axis: +-1e6 voxels, far more than any measuring volume needs.
-std::uint64_t VoxelKey(const Eigen::Vector3f& p, float inv) {
-    auto q = [inv](float v) {
-        return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(v * inv)) +
-                                          (1 << 20)) &
-               0x1FFFFF;
-    };
-    return (q(p.x()) << 42) | (q(p.y()) << 21) | q(p.z());
-}
-
-}  // namespace
-
 Status RegistrationCloudConfig::Validate(const std::string& where) const {
     auto bad = [&](const std::string& f, const std::string& why) -> Status {
         return Error{"INVALID_CONFIG", where + "." + f + ": " + why};
