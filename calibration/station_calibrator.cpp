@@ -92,8 +92,8 @@ Result<InitialEstimate> EstimateInitial(const Session& session, const MeasureCon
         const auto i = static_cast<std::size_t>(k);
         views[i] = SegmentView(est.depths[i], session.camera, session.calibration,
                                table->camera_to_table, mc.segmentation);
-        clouds[i].coarse = BuildRegistrationCloud(views[i].points, mc.registration.coarse_cloud);
-        clouds[i].fine = BuildRegistrationCloud(views[i].points, mc.registration.fine_cloud);
+        clouds[i] = BuildRegistrationClouds(views[i].points, mc.registration.coarse_cloud,
+                                            mc.registration.fine_cloud);
     });
     long object_points = 0;
     for (int k = 0; k < n; ++k) {

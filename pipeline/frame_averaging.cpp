@@ -65,7 +65,17 @@ Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, doubl
         if (k < required) continue;
         // Median of the valid readings (lower median for even counts: deterministic, and the
         // agreement window below is symmetric enough for it).
-        std::nth_element(r, r + (k - 1) / 2, r + k);
+        if (k <= 16) {
+            // Insertion sort: a handful of readings per pixel, far cheaper than nth_element.
+            for (std::size_t a = 1; a < k; ++a) {
+                const std::uint16_t v = r[a];
+                std::size_t b = a;
+                for (; b > 0 && r[b - 1] > v; --b) r[b] = r[b - 1];
+                r[b] = v;
+            }
+        } else {
+            std::nth_element(r, r + (k - 1) / 2, r + k);
+        }
         const double median = r[(k - 1) / 2] * depth_unit_m;
         const double tol = config.agreement_abs_m + config.agreement_rel_per_m * median * median;
         double sum = 0.0;

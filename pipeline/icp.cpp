@@ -1,36 +1,16 @@
 #include "pipeline/icp.h"
 
-#include <pcl/kdtree/kdtree_flann.h>
-#include <pcl/point_cloud.h>
-#include <pcl/point_types.h>
-
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <vector>
 
 namespace boxd {
 
-struct IcpTarget::Index {
-    pcl::KdTreeFLANN<pcl::PointXYZ> tree;
-};
-
-IcpTarget::IcpTarget(OrientedPoints cloud) : cloud_(std::move(cloud)), index_(new Index) {
-    pcl::PointCloud<pcl::PointXYZ>::Ptr pc(new pcl::PointCloud<pcl::PointXYZ>);
-    pc->reserve(cloud_.points.size());
-    for (const auto& p : cloud_.points) pc->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-    if (!pc->empty()) index_->tree.setInputCloud(pc);
-}
-IcpTarget::~IcpTarget() = default;
-IcpTarget::IcpTarget(IcpTarget&&) noexcept = default;
-IcpTarget& IcpTarget::operator=(IcpTarget&&) noexcept = default;
+IcpTarget::IcpTarget(OrientedPoints cloud, double cell_m)
+    : cloud_(std::move(cloud)), grid_(cloud_.points, static_cast<float>(cell_m)) {}
 
 int IcpTarget::Nearest(const Eigen::Vector3f& p, float max_dist) const {
-    if (cloud_.points.empty()) return -1;
-    // Scratch buffers reused across queries (one set per thread).
-    thread_local std::vector<int> idx(1);
-    thread_local std::vector<float> d2(1);
-    if (index_->tree.nearestKSearch(pcl::PointXYZ(p.x(), p.y(), p.z()), 1, idx, d2) < 1) return -1;
-    return d2[0] <= max_dist * max_dist ? idx[0] : -1;
+    return grid_.Nearest(p, max_dist);
 }
 
 Status IcpConfig::Validate(const std::string& where) const {

@@ -3,8 +3,8 @@
 // registration are this one function with two configs.
 
 #include <Eigen/Core>
-#include <memory>
 
+#include "pipeline/nearest_grid.h"
 #include "pipeline/point_cloud.h"
 #include "pipeline/result.h"
 #include "pipeline/se2.h"
@@ -52,22 +52,19 @@ struct IcpResult {
     int iterations = 0;
 };
 
-// A target cloud with its search index, built once and shared by every alignment onto it.
+// A target cloud with its search grid, built once and shared by every alignment onto it. The
+// grid's cell is best set to the correspondence gate of the alignments that use it.
 class IcpTarget {
 public:
-    explicit IcpTarget(OrientedPoints cloud);
-    ~IcpTarget();
-    IcpTarget(IcpTarget&&) noexcept;
-    IcpTarget& operator=(IcpTarget&&) noexcept;
+    IcpTarget(OrientedPoints cloud, double cell_m);
 
     const OrientedPoints& cloud() const { return cloud_; }
     // Returns the index of the nearest target point within `max_dist`, or -1.
     int Nearest(const Eigen::Vector3f& p, float max_dist) const;
 
 private:
-    struct Index;
     OrientedPoints cloud_;
-    std::unique_ptr<Index> index_;
+    NearestGrid grid_;
 };
 
 // Returns the SE(2) motion that best aligns `source` onto `target`, starting from `init`, by

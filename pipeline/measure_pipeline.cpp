@@ -141,9 +141,8 @@ Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig
         const auto i = static_cast<std::size_t>(k);
         views[i] = SegmentView(depths[i], session.camera, session.calibration,
                                table->camera_to_table, config.segmentation);
-        clouds[i].coarse =
-            BuildRegistrationCloud(views[i].points, config.registration.coarse_cloud);
-        clouds[i].fine = BuildRegistrationCloud(views[i].points, config.registration.fine_cloud);
+        clouds[i] = BuildRegistrationClouds(views[i].points, config.registration.coarse_cloud,
+                                            config.registration.fine_cloud);
         views[i].points = Points{};  // only the fusion subset is needed from here on
     });
     depths.clear();

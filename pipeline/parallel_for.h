@@ -1,8 +1,9 @@
 #pragma once
-// A minimal static parallel loop: index i runs on thread i % threads, results go to per-index
-// slots, so the outcome never depends on thread timing.
+// A minimal parallel loop: threads take the next index from a shared counter (so uneven work
+// balances), and results go to per-index slots, so the outcome never depends on thread timing.
 
 #include <algorithm>
+#include <atomic>
 #include <thread>
 #include <vector>
 
@@ -16,14 +17,14 @@ void ParallelFor(int count, int threads, Fn&& fn) {
         for (int i = 0; i < count; ++i) fn(i);
         return;
     }
+    std::atomic<int> next{0};
+    auto work = [&fn, &next, count] {
+        for (int i = next.fetch_add(1); i < count; i = next.fetch_add(1)) fn(i);
+    };
     std::vector<std::thread> pool;
     pool.reserve(static_cast<std::size_t>(n - 1));
-    for (int t = 1; t < n; ++t) {
-        pool.emplace_back([&fn, t, n, count] {
-            for (int i = t; i < count; i += n) fn(i);
-        });
-    }
-    for (int i = 0; i < count; i += n) fn(i);
+    for (int t = 1; t < n; ++t) pool.emplace_back(work);
+    work();
     for (std::thread& th : pool) th.join();
 }
 

@@ -31,35 +31,59 @@ Status RegistrationCloudConfig::Validate(const std::string& where) const {
     return OkStatus();
 }
 
-Points VoxelDownsample(const Points& points, double voxel_m) {
+namespace {
+
+// Voxel centroids with the number of input points each one stands for.
+struct WeightedVoxels {
+    Points centroids;
+    std::vector<float> weights;
+};
+
+// Returns the (weighted) centroids of the occupied voxels of size `voxel_m`, in voxel-key order;
+// `weights` may be null (every point counts once).
+WeightedVoxels VoxelGrid(const Points& points, const std::vector<float>* weights, double voxel_m) {
     const float inv = static_cast<float>(1.0 / voxel_m);
     std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(points.size());
     for (std::size_t i = 0; i < points.size(); ++i) {
         keyed[i] = {VoxelKey(points[i], inv), static_cast<std::uint32_t>(i)};
     }
     std::sort(keyed.begin(), keyed.end());
-    Points out;
+    WeightedVoxels out;
     for (std::size_t i = 0; i < keyed.size();) {
         std::size_t j = i;
         Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+        double weight = 0.0;
         while (j < keyed.size() && keyed[j].first == keyed[i].first) {
-            sum += points[keyed[j].second].cast<double>();
+            const std::uint32_t k = keyed[j].second;
+            const double wk = weights ? (*weights)[k] : 1.0;
+            sum += wk * points[k].cast<double>();
+            weight += wk;
             ++j;
         }
-        out.push_back((sum / static_cast<double>(j - i)).cast<float>());
+        out.centroids.push_back((sum / weight).cast<float>());
+        out.weights.push_back(static_cast<float>(weight));
         i = j;
     }
     return out;
 }
 
-OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config) {
-    OrientedPoints out;
-    Points voxels = VoxelDownsample(points, config.voxel_m);
-    if (voxels.size() > static_cast<std::size_t>(config.max_points)) {
-        // Surface samples scale with 1 / voxel², so this voxel lands near max_points.
-        const double grow = std::sqrt(static_cast<double>(voxels.size()) / config.max_points);
-        voxels = VoxelDownsample(points, config.voxel_m * grow);
+// Returns `base` regridded at the config's voxel, or coarser so that it stays near max_points
+// (surface samples scale with 1 / voxel²).
+Points ReduceVoxels(const WeightedVoxels& base, double base_voxel_m,
+                    const RegistrationCloudConfig& config) {
+    WeightedVoxels v = config.voxel_m > base_voxel_m
+                           ? VoxelGrid(base.centroids, &base.weights, config.voxel_m)
+                           : base;
+    if (v.centroids.size() > static_cast<std::size_t>(config.max_points)) {
+        const double grow = std::sqrt(static_cast<double>(v.centroids.size()) / config.max_points);
+        v = VoxelGrid(base.centroids, &base.weights, std::max(config.voxel_m, base_voxel_m) * grow);
     }
+    return std::move(v.centroids);
+}
+
+// Statistical outlier removal and normals of the voxel centroids.
+OrientedPoints Orient(const Points& voxels, const RegistrationCloudConfig& config) {
+    OrientedPoints out;
     if (voxels.size() < static_cast<std::size_t>(config.normal_neighbors) + 1) return out;
     pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
     cloud->reserve(voxels.size());
@@ -93,6 +117,26 @@ OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCl
         out.normals.push_back(Eigen::Vector3f(n.normal_x, n.normal_y, n.normal_z).normalized());
     }
     return out;
+}
+
+}  // namespace
+
+Points VoxelDownsample(const Points& points, double voxel_m) {
+    return VoxelGrid(points, nullptr, voxel_m).centroids;
+}
+
+OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config) {
+    return Orient(ReduceVoxels(VoxelGrid(points, nullptr, config.voxel_m), config.voxel_m, config),
+                  config);
+}
+
+RegistrationClouds BuildRegistrationClouds(const Points& points,
+                                           const RegistrationCloudConfig& coarse,
+                                           const RegistrationCloudConfig& fine) {
+    const double base_voxel = std::min(coarse.voxel_m, fine.voxel_m);
+    const WeightedVoxels base = VoxelGrid(points, nullptr, base_voxel);
+    return {Orient(ReduceVoxels(base, base_voxel, coarse), coarse),
+            Orient(ReduceVoxels(base, base_voxel, fine), fine)};
 }
 
 }  // namespace boxd

@@ -27,6 +27,19 @@ struct RegistrationCloudConfig {
 // voxel centroids come out in voxel-key order.
 OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config);
 
+// A view's two registration clouds: sparse for the coarse alignment, denser for the fine one.
+struct RegistrationClouds {
+    OrientedPoints coarse;
+    OrientedPoints fine;
+};
+
+// Returns both clouds of `points` from one voxel pass at the finer of the two voxels (the
+// coarser cloud regrids its weighted centroids): the same clouds, up to centroid rounding, at a
+// fraction of the cost of two BuildRegistrationCloud calls.
+RegistrationClouds BuildRegistrationClouds(const Points& points,
+                                           const RegistrationCloudConfig& coarse,
+                                           const RegistrationCloudConfig& fine);
+
 // Returns the centroids of the occupied voxels of size `voxel_m`, in voxel-key order.
 Points VoxelDownsample(const Points& points, double voxel_m);
 

@@ -36,10 +36,7 @@ struct RegistrationConfig {
 };
 
 // Per view: the coarse and the fine registration cloud.
-struct ViewClouds {
-    OrientedPoints coarse;
-    OrientedPoints fine;
-};
+using ViewClouds = RegistrationClouds;
 
 struct EdgeStats {
     int attempted = 0;

@@ -39,7 +39,7 @@ TEST(AlignIcp, RecoversKnownPlanarMotionCoarseThenFine) {
     const Se2 truth{0.012, -0.008, 3.0 * M_PI / 180.0};
     // The source is the same scene seen after the inverse motion: truth maps it back.
     const Points source_pts = Move(BoxView(0.0005, 2), truth.Inverse());
-    IcpTarget target(BuildRegistrationCloud(target_pts, cloud_cfg));
+    IcpTarget target(BuildRegistrationCloud(target_pts, cloud_cfg), 0.01);
     const OrientedPoints source = BuildRegistrationCloud(source_pts, cloud_cfg);
     IcpConfig coarse;
     coarse.max_correspondence_m = 0.03;
@@ -61,7 +61,7 @@ TEST(AlignIcp, RecoversKnownPlanarMotionCoarseThenFine) {
 TEST(AlignIcp, ReportsNoOverlap) {
     const RegistrationCloudConfig cloud_cfg;
     const Points pts = BoxView(0.0, 3);
-    IcpTarget target(BuildRegistrationCloud(pts, cloud_cfg));
+    IcpTarget target(BuildRegistrationCloud(pts, cloud_cfg), 0.01);
     const OrientedPoints far = BuildRegistrationCloud(Move(pts, Se2{1.0, 0.0, 0.0}), cloud_cfg);
     const IcpResult r = AlignIcp(far, target, Se2{}, IcpConfig{});
     EXPECT_FALSE(r.converged);

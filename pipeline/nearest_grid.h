@@ -1,0 +1,36 @@
+#pragma once
+// Exact nearest-neighbour lookup within a radius on a uniform grid: the hot loop of ICP, where
+// every source point asks for its nearest target point within the correspondence gate.
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <vector>
+
+#include "pipeline/point_cloud.h"
+
+namespace boxd {
+
+class NearestGrid {
+public:
+    NearestGrid() = default;
+    // Buckets `points` into cubic cells of edge `cell_m` (grown when the bounding box would need
+    // more than `max_cells` cells). Queries are fastest when the search radius is near cell_m.
+    NearestGrid(const Points& points, float cell_m, std::size_t max_cells = 8u << 20);
+
+    // Returns the index (into the constructor's points) of the nearest point within `max_dist`
+    // of `p`, or -1. Ties go to the lower index, so the answer never depends on the layout.
+    int Nearest(const Eigen::Vector3f& p, float max_dist) const;
+
+    float cell_m() const { return cell_; }
+
+private:
+    Eigen::Vector3f origin_ = Eigen::Vector3f::Zero();
+    float cell_ = 0.0f;
+    float inv_cell_ = 0.0f;
+    int nx_ = 0, ny_ = 0, nz_ = 0;
+    std::vector<std::uint32_t> start_;  // first slot of each cell in sorted_, plus an end mark
+    std::vector<std::uint32_t> index_;  // original index of each slot
+    Points sorted_;                     // the points grouped by cell
+};
+
+}  // namespace boxd
