@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <map>
+#include <string>
 #include <vector>
 
 #include "daemon/cli.h"
@@ -22,6 +24,18 @@ struct BenchOptions {
     int threads = 2;
 };
 
+double CpuSeconds() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+           1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+double Median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+}
+
 int RunBench(const BenchOptions& opt) {
     using Clock = std::chrono::steady_clock;
     const auto t0 = Clock::now();
@@ -32,7 +46,9 @@ int RunBench(const BenchOptions& opt) {
     config.threads = opt.threads;
     config.registration.threads = opt.threads;
     std::vector<double> wall;
+    std::map<std::string, std::vector<double>> stages;
     std::string status;
+    const double cpu0 = CpuSeconds();
     for (int i = 0; i < opt.runs; ++i) {
         const auto a = Clock::now();
         auto out = MeasureSession(*session, config, BoxMethod::kFootprint);
@@ -42,7 +58,9 @@ int RunBench(const BenchOptions& opt) {
             return kExitInternal;
         }
         status = StatusName(out->result.status);
+        for (const auto& [name, ms] : out->result.timing_ms) stages[name].push_back(ms);
     }
+    const double cpu_ms = 1000.0 * (CpuSeconds() - cpu0) / opt.runs;
     std::vector<double> sorted = wall;
     std::sort(sorted.begin(), sorted.end());
     rusage usage{};
@@ -52,6 +70,13 @@ int RunBench(const BenchOptions& opt) {
     std::printf("load (PNG decode): %.1f ms\n", load_ms);
     std::printf("processing over %d runs: median %.1f ms, min %.1f ms, max %.1f ms\n", opt.runs,
                 sorted[sorted.size() / 2], sorted.front(), sorted.back());
+    std::printf("CPU time per run (all threads): %.1f ms\n", cpu_ms);
+    std::printf("stage medians:");
+    for (const auto& [name, ms] : stages) {
+        if (name != "capture" && name != "processing")
+            std::printf(" %s %.1f ms", name.c_str(), Median(ms));
+    }
+    std::printf("\n");
     std::printf("peak RSS: %.1f MB\n", static_cast<double>(usage.ru_maxrss) / 1024.0);
     return kExitOk;
 }

@@ -20,7 +20,8 @@ Status CameraIntrinsics::Validate(const std::string& where) const {
     if (!PositiveFinite(fy)) return bad("fy", "must be a positive finite number");
     if (!std::isfinite(cx) || cx < 0.0) return bad("cx", "must be a non-negative finite number");
     if (!std::isfinite(cy) || cy < 0.0) return bad("cy", "must be a non-negative finite number");
-    if (!PositiveFinite(depth_unit_m)) return bad("depth_unit_m", "must be a positive finite number");
+    if (!PositiveFinite(depth_unit_m))
+        return bad("depth_unit_m", "must be a positive finite number");
     return OkStatus();
 }
 

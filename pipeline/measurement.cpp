@@ -43,8 +43,8 @@ json ToJson(const MeasurementResult& m) {
     j["started_at"] = m.started_at;
     j["finished_at"] = m.finished_at;
     j["status"] = StatusName(m.status);
-    j["reason"] = m.reason ? json{{"code", m.reason->code}, {"message", m.reason->message}}
-                           : json(nullptr);
+    j["reason"] =
+        m.reason ? json{{"code", m.reason->code}, {"message", m.reason->message}} : json(nullptr);
     if (m.dimensions) {
         const auto& d = *m.dimensions;
         j["dimensions"] = {{"length_m", Round(d.length_m, 1e-5)},
@@ -57,13 +57,13 @@ json ToJson(const MeasurementResult& m) {
     }
     if (m.obb) {
         const auto& b = *m.obb;
-        j["obb"] = {{"method", b.method},
-                    {"extent_m", Array3(b.extent_m, 1e-5)},
-                    {"volume_m3", Round(b.volume_m3, 1e-7)},
-                    {"center_m", Array3(b.center_m, 1e-5)},
-                    {"axes", {Array3(b.axes[0], 1e-6), Array3(b.axes[1], 1e-6),
-                              Array3(b.axes[2], 1e-6)}},
-                    {"frame", b.frame}};
+        j["obb"] = {
+            {"method", b.method},
+            {"extent_m", Array3(b.extent_m, 1e-5)},
+            {"volume_m3", Round(b.volume_m3, 1e-7)},
+            {"center_m", Array3(b.center_m, 1e-5)},
+            {"axes", {Array3(b.axes[0], 1e-6), Array3(b.axes[1], 1e-6), Array3(b.axes[2], 1e-6)}},
+            {"frame", b.frame}};
     } else {
         j["obb"] = nullptr;
     }

@@ -39,30 +39,40 @@ struct WeightedVoxels {
     std::vector<float> weights;
 };
 
-// Returns the (weighted) centroids of the occupied voxels of size `voxel_m`, in voxel-key order;
-// `weights` may be null (every point counts once).
+// Returns the (weighted) centroids of the occupied voxels of size `voxel_m`, in the order the
+// voxels are first met in `points`; `weights` may be null (every point counts once). Voxels are
+// found through an open-addressing hash table: far cheaper than sorting the keys.
 WeightedVoxels VoxelGrid(const Points& points, const std::vector<float>* weights, double voxel_m) {
     const float inv = static_cast<float>(1.0 / voxel_m);
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(points.size());
+    std::size_t capacity = 16;
+    while (capacity < 2 * points.size()) capacity <<= 1;
+    const int shift = 64 - __builtin_ctzll(capacity);
+    std::vector<std::uint64_t> keys(capacity);
+    std::vector<std::int32_t> slot_of(capacity, -1);
+    std::vector<Eigen::Vector3d> sums;
+    std::vector<double> totals;
     for (std::size_t i = 0; i < points.size(); ++i) {
-        keyed[i] = {VoxelKey(points[i], inv), static_cast<std::uint32_t>(i)};
-    }
-    std::sort(keyed.begin(), keyed.end());
-    WeightedVoxels out;
-    for (std::size_t i = 0; i < keyed.size();) {
-        std::size_t j = i;
-        Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-        double weight = 0.0;
-        while (j < keyed.size() && keyed[j].first == keyed[i].first) {
-            const std::uint32_t k = keyed[j].second;
-            const double wk = weights ? (*weights)[k] : 1.0;
-            sum += wk * points[k].cast<double>();
-            weight += wk;
-            ++j;
+        const std::uint64_t key = VoxelKey(points[i], inv);
+        // Fibonacci hashing (Knuth, TAOCP 6.4), linear probing.
+        std::size_t h = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> shift);
+        while (slot_of[h] >= 0 && keys[h] != key) h = (h + 1) & (capacity - 1);
+        if (slot_of[h] < 0) {
+            keys[h] = key;
+            slot_of[h] = static_cast<std::int32_t>(sums.size());
+            sums.emplace_back(Eigen::Vector3d::Zero());
+            totals.push_back(0.0);
         }
-        out.centroids.push_back((sum / weight).cast<float>());
-        out.weights.push_back(static_cast<float>(weight));
-        i = j;
+        const auto v = static_cast<std::size_t>(slot_of[h]);
+        const double w = weights ? (*weights)[i] : 1.0;
+        sums[v] += w * points[i].cast<double>();
+        totals[v] += w;
+    }
+    WeightedVoxels out;
+    out.centroids.reserve(sums.size());
+    out.weights.reserve(sums.size());
+    for (std::size_t v = 0; v < sums.size(); ++v) {
+        out.centroids.push_back((sums[v] / totals[v]).cast<float>());
+        out.weights.push_back(static_cast<float>(totals[v]));
     }
     return out;
 }

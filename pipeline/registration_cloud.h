@@ -24,7 +24,7 @@ struct RegistrationCloudConfig {
 };
 
 // Returns the downsampled, outlier-free cloud of `points` with unit normals. Deterministic: the
-// voxel centroids come out in voxel-key order.
+// voxel centroids come out in the order their voxels are first met in `points`.
 OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config);
 
 // A view's two registration clouds: sparse for the coarse alignment, denser for the fine one.
@@ -40,7 +40,7 @@ RegistrationClouds BuildRegistrationClouds(const Points& points,
                                            const RegistrationCloudConfig& coarse,
                                            const RegistrationCloudConfig& fine);
 
-// Returns the centroids of the occupied voxels of size `voxel_m`, in voxel-key order.
+// Returns the centroids of the occupied voxels of size `voxel_m`, in first-met order.
 Points VoxelDownsample(const Points& points, double voxel_m);
 
 }  // namespace boxd

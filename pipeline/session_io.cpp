@@ -37,7 +37,8 @@ public:
         return &*it;
     }
 
-    Result<double> Number(const json& obj, const std::string& parent, const std::string& key) const {
+    Result<double> Number(const json& obj, const std::string& parent,
+                          const std::string& key) const {
         auto m = Member(obj, parent, key);
         if (!m) return m.error();
         const std::string field = parent + "." + key;
@@ -99,8 +100,8 @@ Result<CameraIntrinsics> ParseCamera(const JsonReader& r, const json& root) {
         const char* key;
         double* dst;
     };
-    for (Field f : {Field{"fx", &c.fx}, Field{"fy", &c.fy}, Field{"cx", &c.cx},
-                    Field{"cy", &c.cy}, Field{"depth_unit_m", &c.depth_unit_m}}) {
+    for (Field f : {Field{"fx", &c.fx}, Field{"fy", &c.fy}, Field{"cx", &c.cx}, Field{"cy", &c.cy},
+                    Field{"depth_unit_m", &c.depth_unit_m}}) {
         auto v = r.Number(j, "camera", f.key);
         if (!v) return v.error();
         *f.dst = *v;
@@ -149,13 +150,13 @@ Result<DepthImage> ReadFrame(const fs::path& file, const std::string& field,
         return SessionError(file, field,
                             "image is " + std::to_string(img.cols) + "x" +
                                 std::to_string(img.rows) + ", camera says " +
-                                std::to_string(camera.width) + "x" +
-                                std::to_string(camera.height));
+                                std::to_string(camera.width) + "x" + std::to_string(camera.height));
     }
     DepthImage out(img.cols, img.rows);
     for (int y = 0; y < img.rows; ++y) {
         const auto* row = img.ptr<std::uint16_t>(y);
-        std::copy(row, row + img.cols, out.pixels.begin() + static_cast<std::ptrdiff_t>(y) * img.cols);
+        std::copy(row, row + img.cols,
+                  out.pixels.begin() + static_cast<std::ptrdiff_t>(y) * img.cols);
     }
     return out;
 }
@@ -166,8 +167,8 @@ Result<std::vector<SessionPose>> ParsePoses(const JsonReader& r, const json& roo
     const json& arr = **poses;
     if (!arr.is_array()) return SessionError(r.file(), "poses", "must be an array");
     if (arr.empty() || arr.size() > 360) {
-        return SessionError(r.file(), "poses", "must hold 1 to 360 poses, has " +
-                                                   std::to_string(arr.size()));
+        return SessionError(r.file(), "poses",
+                            "must hold 1 to 360 poses, has " + std::to_string(arr.size()));
     }
     std::vector<SessionPose> out(arr.size());
     for (std::size_t i = 0; i < arr.size(); ++i) {
@@ -187,8 +188,9 @@ Result<std::vector<SessionPose>> ParsePoses(const JsonReader& r, const json& roo
             const std::string p = f[k].get<std::string>();
             if (!IsContainedRelativePath(p)) {
                 return SessionError(r.file(), field,
-                                    "path '" + p + "' must be relative and stay inside the session "
-                                    "folder (no absolute paths, no '..')");
+                                    "path '" + p +
+                                        "' must be relative and stay inside the session "
+                                        "folder (no absolute paths, no '..')");
             }
             out[i].frame_paths.push_back(p);
         }
@@ -256,8 +258,9 @@ Result<Session> LoadSession(const fs::path& dir) {
     auto format = r.Member(root, "", "format");
     if (!format) return format.error();
     if (!(*format)->is_string() || (*format)->get<std::string>() != kSessionFormat) {
-        return SessionError(file, "format",
-                            std::string("must be \"") + kSessionFormat + "\", got " + (*format)->dump());
+        return SessionError(
+            file, "format",
+            std::string("must be \"") + kSessionFormat + "\", got " + (*format)->dump());
     }
 
     Session s;
@@ -353,10 +356,16 @@ Status WriteSession(const Session& session, const fs::path& dir) {
         {"format", kSessionFormat},
         {"source", session.source},
         {"camera",
-         {{"width", c.width}, {"height", c.height}, {"fx", c.fx}, {"fy", c.fy}, {"cx", c.cx},
-          {"cy", c.cy}, {"depth_unit_m", c.depth_unit_m}}},
+         {{"width", c.width},
+          {"height", c.height},
+          {"fx", c.fx},
+          {"fy", c.fy},
+          {"cx", c.cx},
+          {"cy", c.cy},
+          {"depth_unit_m", c.depth_unit_m}}},
         {"calibration",
-         {{"table_center_m", {cal.table_center_m.x(), cal.table_center_m.y(), cal.table_center_m.z()}},
+         {{"table_center_m",
+           {cal.table_center_m.x(), cal.table_center_m.y(), cal.table_center_m.z()}},
           {"table_axis", {cal.table_axis.x(), cal.table_axis.y(), cal.table_axis.z()}},
           {"depth_offset_m", cal.depth_offset_m},
           {"depth_scale", cal.depth_scale}}},

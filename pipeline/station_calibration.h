@@ -10,7 +10,7 @@
 namespace boxd {
 
 struct StationCalibration {
-    Eigen::Vector3d table_center_m{0.0, 0.31, 0.83};  // axis meets table top, camera frame
+    Eigen::Vector3d table_center_m{0.0, 0.31, 0.83};   // axis meets table top, camera frame
     Eigen::Vector3d table_axis{0.0, -0.866025, -0.5};  // unit, camera frame, pointing up
     double depth_offset_m = 0.0;  // corrected z = raw z * depth_scale + depth_offset_m
     double depth_scale = 1.0;

@@ -58,8 +58,10 @@ std::vector<PoseEdge> RegisterViewPairs(const std::vector<ViewClouds>& views,
     std::vector<std::unique_ptr<IcpTarget>> fine_targets(static_cast<std::size_t>(n));
     ParallelFor(n, config.threads, [&](int k) {
         const auto i = static_cast<std::size_t>(k);
-        coarse_targets[i] = std::make_unique<IcpTarget>(views[i].coarse, config.coarse.max_correspondence_m);
-        fine_targets[i] = std::make_unique<IcpTarget>(views[i].fine, config.fine.max_correspondence_m);
+        coarse_targets[i] =
+            std::make_unique<IcpTarget>(views[i].coarse, config.coarse.max_correspondence_m);
+        fine_targets[i] =
+            std::make_unique<IcpTarget>(views[i].fine, config.fine.max_correspondence_m);
     });
     std::vector<PoseEdge> edges(list.size());
     std::vector<IcpResult> results(list.size());

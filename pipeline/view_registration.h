@@ -21,9 +21,9 @@ struct RegistrationConfig {
                      .yaw_tolerance_rad = 1e-4,
                      .robust_scale_m = 0.008};
     IcpConfig fine{.max_correspondence_m = 0.008,
-                   .max_iterations = 20,
-                   .translation_tolerance_m = 2e-5,
-                   .yaw_tolerance_rad = 2e-5,
+                   .max_iterations = 10,
+                   .translation_tolerance_m = 5e-5,
+                   .yaw_tolerance_rad = 5e-5,
                    .robust_scale_m = 0.003};
     int max_pose_step = 3;  // pairs up to this many poses apart (cyclically) are aligned ...
     double max_pair_angle_deg = 100.0;  // ... when their turntable angles differ by at most this

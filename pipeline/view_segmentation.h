@@ -22,7 +22,7 @@ struct SegmentationConfig {
     int border_margin_px = 2;  // object readings this close to the image border are "cut"
     // Fusion and box fitting use every n-th pixel in x and y: at 1 m the sensor samples the box
     // every ~2 mm, far denser than the fits need, and the face means stay unbiased.
-    int fusion_pixel_stride = 2;
+    int fusion_pixel_stride = 3;
 
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;

@@ -36,7 +36,7 @@ TEST(NearestGrid, MatchesBruteForceForEveryRadius) {
             found += want >= 0;
         }
     }
-    EXPECT_GT(found, 500);   // the queries did hit points, not only empty space
+    EXPECT_GT(found, 500);  // the queries did hit points, not only empty space
 }
 
 TEST(NearestGrid, EmptyAndFarQueriesFindNothing) {
