@@ -132,6 +132,16 @@ Result<InitialEstimate> EstimateInitial(const Session& session, const MeasureCon
                                               report->max_model_translation_deviation_m * 1000.0) +
                                           "): the reference box moved on the table"};
     }
+    // The measurement pipeline's moved-object test: when more alignments than this fraction
+    // disagree with the rest, the views show the box in two places.
+    const int graph_edges = report->rejected_edges + report->active_edges;
+    if (graph_edges > 0 &&
+        report->rejected_edges > refuse.max_rejected_edge_fraction * graph_edges) {
+        return Error{code::kBoxMoved, std::to_string(report->rejected_edges) + " of " +
+                                          std::to_string(graph_edges) +
+                                          " view alignments disagree with the others: the "
+                                          "reference box moved on the table"};
+    }
     if (report->active_edges == 0 ||
         report->unconstrained_nodes > refuse.max_unconstrained_fraction * n) {
         return Error{code::kBoxMoved, "too few views of the reference box could be registered (" +
@@ -233,6 +243,8 @@ Status CalibrationConfig::Validate() const {
         return bad("outer_iterations", "must be in 1..20");
     }
     if (max_solver_iterations < 1) return bad("max_solver_iterations", "must be >= 1");
+    if (!(face_rms_ratio >= 1.0)) return bad("face_rms_ratio", "must be >= 1");
+    if (!(face_rms_floor_m > 0.0)) return bad("face_rms_floor_m", "must be > 0");
     return OkStatus();
 }
 
@@ -298,6 +310,15 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
     jc.threads = config.measure.threads;
     auto sol = RefineJointly(views, session.camera, ref, init, jc);
     if (!sol) return sol.error();
+    const double face_rms_limit =
+        std::max(config.face_rms_ratio * sol->table_rms_m, config.face_rms_floor_m);
+    if (sol->face_rms_m > face_rms_limit) {
+        return Error{code::kNotConverged,
+                     Fmt("no station geometry makes the views show a box of the stated size: its "
+                         "faces fit to %.1f mm RMS (limit %.1f mm, table %.1f mm); check the "
+                         "reference size, and that the box is rigid and did not move",
+                         sol->face_rms_m * 1e3, face_rms_limit * 1e3, sol->table_rms_m * 1e3)};
+    }
 
     report.calibration = sol->calibration;
     report.depth_scale_estimated = config.estimate_depth_scale;

@@ -50,6 +50,13 @@ struct CalibrationConfig {
     double band_sigmas = 3.5;          // later assignments keep points within this many sigmas
     int outer_iterations = 4;          // re-assignments of points to faces
     int max_solver_iterations = 50;
+    // Acceptance of the solution: the box points must lie on the faces of a box of the stated
+    // size about as tightly as the table points lie on the table (both are the sensor's noise at
+    // a similar distance). A face RMS above max(face_rms_ratio * table RMS, face_rms_floor_m)
+    // means no station geometry makes the views show the stated box (a reference a few percent
+    // off its stated size, a moved or soft box): NOT_CONVERGED rather than a bent calibration.
+    double face_rms_ratio = 2.0;
+    double face_rms_floor_m = 0.0015;
 
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;

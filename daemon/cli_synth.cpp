@@ -34,7 +34,7 @@ struct SynthOptions {
     double yaw_deg = 0.0;
     std::optional<double> distance_m, elevation_deg, aim_height_m;
     std::optional<double> angle_error_deg, calib_center_error_m, calib_axis_error_deg;
-    std::optional<double> depth_offset_m;
+    std::optional<double> depth_offset_m, calib_depth_offset_error_m;
     std::optional<int> move_at_pose;
     std::vector<double> move_by;
     bool force = false;
@@ -120,6 +120,7 @@ Result<SyntheticStationConfig> MakeConfig(const SynthOptions& o) {
     if (o.calib_center_error_m) c.calib_center_error_m = *o.calib_center_error_m;
     if (o.calib_axis_error_deg) c.calib_axis_error_deg = *o.calib_axis_error_deg;
     if (o.depth_offset_m) c.true_depth_offset_m = *o.depth_offset_m;
+    if (o.calib_depth_offset_error_m) c.calib_depth_offset_error_m = *o.calib_depth_offset_error_m;
     if (o.move_at_pose) {
         c.moved_at_pose = *o.move_at_pose;
         if (!o.move_by.empty()) {
@@ -199,6 +200,9 @@ void AddSynth(CLI::App& app, Runner& run) {
                     "Axis tilt error of the recorded calibration (deg)");
     sub->add_option("--depth-offset-m", o->depth_offset_m,
                     "Sensor depth bias: raw z = true z - offset (m)");
+    sub->add_option("--calib-depth-offset-error-m", o->calib_depth_offset_error_m,
+                    "Depth offset error of the recorded calibration (m, signed): it records the "
+                    "sensor bias plus this; minus the bias records 0 (depth never calibrated)");
     sub->add_option("--move-at-pose", o->move_at_pose, "The box is moved from this pose on");
     sub->add_option("--move-by", o->move_by, "The move: DX DY (m) DYAW (deg)")->expected(3);
     sub->add_flag("--force", o->force, "Write into a non-empty folder that holds no session");

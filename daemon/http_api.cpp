@@ -21,6 +21,9 @@ namespace {
 
 const auto kProcessStart = std::chrono::steady_clock::now();
 
+// GET /v1/calibration lists this many of the latest calibrations.
+constexpr int kCalibrationHistoryShown = 20;
+
 void SetError(Response& res, int http_status, const std::string& code, const std::string& message) {
     res.status = http_status;
     res.set_content(json{{"error", {{"code", code}, {"message", message}}}}.dump(),
@@ -335,7 +338,18 @@ void HttpApi::Register(httplib::Server& server) {
                 }));
 
     server.Get("/v1/calibration", Guarded([this](const Request&, Response& res) {
-                   SetJson(res, 200, service_.station()->Calibration());
+                   json j = service_.station()->Calibration();
+                   // Added to the SPEC fields: the latest finished calibrations, newest first.
+                   // Null when the history cannot be read: the calibration in force is still
+                   // served.
+                   auto history = service_.ListCalibrations(kCalibrationHistoryShown);
+                   if (history) {
+                       j["history"] = *history;
+                   } else {
+                       spdlog::error("GET /v1/calibration: {}", history.error().message);
+                       j["history"] = nullptr;
+                   }
+                   SetJson(res, 200, j);
                }));
 }
 

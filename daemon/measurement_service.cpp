@@ -59,7 +59,19 @@ const char* ServiceStateName(ServiceState s) {
 
 MeasurementService::MeasurementService(MeasurementStore& store, std::shared_ptr<Station> station,
                                        bool keep_sessions)
-    : store_(store), station_(std::move(station)), keep_sessions_(keep_sessions) {}
+    : store_(store), station_(std::move(station)), keep_sessions_(keep_sessions) {
+    auto history = CalibrationHistory::Open(store_.data_dir());
+    if (history) {
+        history_ = std::move(*history);
+    } else {
+        spdlog::warn("calibration history unavailable: {}", history.error().message);
+    }
+}
+
+Result<std::vector<json>> MeasurementService::ListCalibrations(int limit) {
+    if (!history_) return Error{kStorageErrorCode, "the calibration history is not available"};
+    return history_->List(limit);
+}
 
 MeasurementService::~MeasurementService() {
     Abort();
@@ -262,6 +274,25 @@ Result<json> MeasurementService::Calibrate(const BoxDimensions& reference,
     return run->result;
 }
 
+void MeasurementService::RecordCalibration(const BoxDimensions& reference,
+                                           const Result<json>& result) {
+    if (!history_) return;
+    CalibrationRecord record;
+    record.finished_at = UtcTimestampNow();
+    record.ok = result.ok();
+    record.reference_m = {reference.length_m, reference.width_m, reference.height_m};
+    if (result) {
+        record.quality = result->value("quality", json(nullptr));
+        record.calibration = result->value("calibration", json(nullptr));
+    } else {
+        record.error_code = result.error().code;
+        record.error_message = result.error().message;
+    }
+    if (Status s = history_->Record(record); !s) {
+        spdlog::error("calibration history: {}", s.error().message);
+    }
+}
+
 void MeasurementService::RunCalibration(std::shared_ptr<CalibrationRun> run,
                                         std::shared_ptr<Station> station) {
     JobContext ctx;
@@ -291,6 +322,7 @@ void MeasurementService::RunCalibration(std::shared_ptr<CalibrationRun> run,
     } else {
         spdlog::error("calibration failed: {}: {}", result.error().code, result.error().message);
     }
+    RecordCalibration(run->reference, result);
     const bool station_ok = station->IsOpen();
     {
         std::lock_guard lock(mutex_);

@@ -14,6 +14,7 @@
 #include <string>
 #include <thread>
 
+#include "daemon/calibration_history.h"
 #include "daemon/measurement_store.h"
 #include "daemon/station.h"
 #include "pipeline/result.h"
@@ -67,6 +68,10 @@ public:
     Result<nlohmann::json> Calibrate(const BoxDimensions& reference,
                                      std::chrono::milliseconds timeout);
 
+    // Returns up to `limit` finished calibrations, newest first (CalibrationHistory::List), or
+    // STORAGE_ERROR when the history is not available.
+    Result<std::vector<nlohmann::json>> ListCalibrations(int limit);
+
     // Stops the running measurement (the table is stopped at once) and refuses new ones.
     void Abort();
     // Waits until no measurement runs.
@@ -88,6 +93,8 @@ private:
     JobOutput RunStation(Station& station, const JobContext& ctx);
     struct CalibrationRun;
     void RunCalibration(std::shared_ptr<CalibrationRun> run, std::shared_ptr<Station> station);
+    // Adds the finished calibration (report or refusal) to the history.
+    void RecordCalibration(const BoxDimensions& reference, const Result<nlohmann::json>& result);
     // Claims the worker for a new run; returns the previous (finished) worker thread to join.
     Result<std::thread> Claim(bool calibrating);
     void Notify();
@@ -111,6 +118,7 @@ private:
     int finished_ = 0;
     std::thread worker_;
     std::function<void()> on_change_;
+    std::unique_ptr<CalibrationHistory> history_;  // null when it could not be opened
 };
 
 }  // namespace boxd

@@ -160,6 +160,11 @@ Status SyntheticStationConfig::Validate() const {
     if (!Finite(true_depth_offset_m) || std::abs(true_depth_offset_m) > 0.5) {
         return Bad("true_depth_offset_m", "must be within +-0.5 metres");
     }
+    if (!Finite(calib_depth_offset_error_m) ||
+        std::abs(true_depth_offset_m + calib_depth_offset_error_m) > 0.5) {
+        return Bad("calib_depth_offset_error_m",
+                   "must be finite and keep the recorded offset within +-0.5 metres");
+    }
     if (moved_at_pose) {
         if (*moved_at_pose < 1) return Bad("moved_at_pose", "must be a pose index >= 1");
         if (!Finite(moved_dx_m)) return Bad("moved_dx_m", "must be finite");
@@ -217,6 +222,7 @@ SyntheticScene MakeSyntheticScene(const SyntheticStationConfig& config) {
     recorded.table_axis =
         (Eigen::AngleAxisd(config.calib_axis_error_deg * kDegToRad, tilt_axis) * truth.table_axis)
             .normalized();
+    recorded.depth_offset_m = truth.depth_offset_m + config.calib_depth_offset_error_m;
     scene.recorded_calibration = recorded;
     return scene;
 }

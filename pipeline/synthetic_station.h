@@ -52,6 +52,10 @@ struct SyntheticStationConfig {
     double calib_center_error_m = 0.003;
     double calib_axis_error_deg = 0.3;
     double true_depth_offset_m = 0.0;  // sensor bias: raw z = true z - offset (scale 1)
+    // The recorded depth offset minus the true one (signed). 0 (the default) records the true
+    // offset, i.e. a station whose depth was already corrected; -true_depth_offset_m records 0,
+    // a station that never learnt of its sensor's bias.
+    double calib_depth_offset_error_m = 0.0;
     // Optional: the box is pushed by (dx, dy) on the table top and turned by dyaw from this pose
     // on (for OBJECT_MOVED tests).
     std::optional<int> moved_at_pose;

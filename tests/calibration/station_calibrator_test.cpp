@@ -1,5 +1,6 @@
 // The station calibration on synthetic sessions with injected errors: the recorded calibration's
-// centre and axis are off and the sensor reads short by a depth offset; the calibration must
+// centre and axis are off and the sensor reads short by a depth offset the recorded calibration
+// does not know (it records 0); the calibration must
 // recover the true values (SyntheticScene::true_calibration) to 1 mm, 0.1 deg and 2 mm.
 #include "calibration/station_calibrator.h"
 
@@ -33,6 +34,9 @@ SyntheticStationConfig ReferenceStation(const Injected& inj) {
     c.calib_center_error_m = inj.center_error_m;
     c.calib_axis_error_deg = inj.axis_error_deg;
     c.true_depth_offset_m = inj.depth_offset_m;
+    // The station never learnt of its sensor's bias: the recorded calibration says 0, so the
+    // offset has to be found, not carried over from the session.
+    c.calib_depth_offset_error_m = -inj.depth_offset_m;
     return c;
 }
 
@@ -69,6 +73,7 @@ TEST_P(RecoversInjectedErrors, CentreAxisAndDepthOffset) {
     EXPECT_LT(centre_err, 0.001);
     EXPECT_LT(axis_err, 0.1);
     EXPECT_LT(std::abs(offset_err), 0.002);
+    EXPECT_EQ(session->calibration.depth_offset_m, 0.0);
     EXPECT_EQ(report->poses_used, 12);
     EXPECT_DOUBLE_EQ(got.depth_scale, 1.0);
 }

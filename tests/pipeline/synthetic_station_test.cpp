@@ -172,6 +172,21 @@ TEST(SyntheticStation, RecordedCalibrationCarriesTheConfiguredErrors) {
         exact.recorded_calibration.table_axis.isApprox(exact.true_calibration.table_axis, 1e-12));
 }
 
+TEST(SyntheticStation, RecordedDepthOffsetCarriesItsError) {
+    SyntheticStationConfig c;
+    c.true_depth_offset_m = 0.01;
+    c.calib_depth_offset_error_m = -0.01;  // a station that never corrected its sensor's bias
+    const SyntheticScene s = MakeSyntheticScene(c);
+    EXPECT_EQ(s.true_calibration.depth_offset_m, 0.01);
+    EXPECT_DOUBLE_EQ(s.recorded_calibration.depth_offset_m, 0.0);
+    c.calib_depth_offset_error_m = 0.004;
+    EXPECT_DOUBLE_EQ(MakeSyntheticScene(c).recorded_calibration.depth_offset_m, 0.014);
+    c.calib_depth_offset_error_m = 0.6;
+    const Status bad = c.Validate();
+    ASSERT_FALSE(bad.ok());
+    EXPECT_NE(bad.error().message.find("calib_depth_offset_error_m"), std::string::npos);
+}
+
 TEST(SyntheticStation, DepthOffsetBiasesTheRawDepths) {
     SyntheticStationConfig c = ExactStation();
     const SyntheticScene plain = MakeSyntheticScene(c);
