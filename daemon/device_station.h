@@ -10,6 +10,7 @@
 #include <mutex>
 #include <optional>
 
+#include "daemon/pose_preparer.h"
 #include "daemon/station.h"
 #include "drivers/driver_registry.h"
 #include "drivers/station_config.h"
@@ -48,7 +49,9 @@ private:
     void MarkDeviceError(const Error& error);
     void CloseDevices();
     // Captures one session with the open devices; progress is reported as "capture".
-    Result<Session> Capture(const JobContext& ctx, double& capture_ms);
+    // Captures a session; with a `preparer`, each pose is handed to it as soon as it is grabbed.
+    Result<Session> Capture(const JobContext& ctx, double& capture_ms,
+                            PosePreparer* preparer = nullptr);
     // Puts the calibration stored in calibration_file in force when it is newer than the
     // config file's.
     void LoadStoredCalibration();

@@ -90,9 +90,47 @@ Status MeasureConfig::Validate() const {
 
 const char* BoxMethodName(BoxMethod m) { return m == BoxMethod::kPca ? "pca" : "footprint"; }
 
+PreparedPose PreparePose(const std::vector<DepthImage>& frames, double depth_unit_m,
+                         const MeasureConfig& config) {
+    PreparedPose out;
+    auto avg = AverageDepthFrames(frames, depth_unit_m, config.averaging);
+    if (!avg) {
+        out.error = avg.error().message;
+        return out;
+    }
+    out.depth = RemoveFlyingPixels(*avg, config.flying_pixels);
+    return out;
+}
+
 Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig& config,
                                      BoxMethod method) {
     if (Status s = config.Validate(); !s) return s.error();
+    const auto start = Clock::now();
+    const int n = static_cast<int>(session.poses.size());
+    std::vector<PreparedPose> prepared(static_cast<std::size_t>(n));
+    ParallelFor(n, config.threads, [&](int k) {
+        const auto i = static_cast<std::size_t>(k);
+        prepared[i] = PreparePose(session.poses[i].frames, session.camera.depth_unit_m, config);
+    });
+    const double first_stage_ms = Ms(start, Clock::now());
+    auto out = MeasurePrepared(session, std::move(prepared), config, method);
+    if (out) {
+        // The whole run, first stage included, as if it were one call.
+        auto& timing = out->result.timing_ms;
+        timing["preprocess"] += first_stage_ms;
+        timing["processing"] += first_stage_ms;
+    }
+    return out;
+}
+
+Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<PreparedPose> poses,
+                                      const MeasureConfig& config, BoxMethod method) {
+    if (Status s = config.Validate(); !s) return s.error();
+    if (poses.size() != session.poses.size()) {
+        return Error{"INTERNAL", "MeasurePrepared: " + std::to_string(poses.size()) +
+                                     " prepared poses for a session of " +
+                                     std::to_string(session.poses.size())};
+    }
     Run run;
     MeasurementResult& res = run.out.result;
     res.id = "offline";
@@ -103,25 +141,14 @@ Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig
     const RefusalConfig& refuse = config.refusal;
     if (n == 0) return run.Refuse(reason::kInsufficientData, "the session has no poses");
 
-    // Stage 1: frame averaging and flying pixels, per pose.
     std::vector<DepthMap> depths(static_cast<std::size_t>(n));
-    std::vector<std::string> errors(static_cast<std::size_t>(n));
-    ParallelFor(n, config.threads, [&](int k) {
-        const auto i = static_cast<std::size_t>(k);
-        auto avg = AverageDepthFrames(session.poses[i].frames, session.camera.depth_unit_m,
-                                      config.averaging);
-        if (!avg) {
-            errors[i] = avg.error().message;
-            return;
-        }
-        depths[i] = RemoveFlyingPixels(*avg, config.flying_pixels);
-    });
     for (int k = 0; k < n; ++k) {
         const auto i = static_cast<std::size_t>(k);
-        if (!errors[i].empty()) {
+        if (!poses[i].error.empty()) {
             return run.Refuse(reason::kInsufficientData,
-                              "pose " + std::to_string(k) + ": " + errors[i]);
+                              "pose " + std::to_string(k) + ": " + poses[i].error);
         }
+        depths[i] = std::move(poses[i].depth);
         const double valid = ValidFraction(depths[i]);
         if (valid < refuse.min_pose_valid_fraction) {
             return run.Refuse(reason::kInsufficientData,
@@ -129,6 +156,7 @@ Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig
                                   Fmt("%.1f%% of its pixels", 100.0 * valid));
         }
     }
+    poses.clear();
 
     // Stage 2: the refitted table frame, then each view's object points.
     auto table = FitTablePlane(depths, session.camera, session.calibration, config.table_plane);

@@ -64,6 +64,24 @@ struct MeasureOutput {
     Points cloud;              // the fused cloud, table frame (empty when not reached)
 };
 
+// One pose after the first stage (frame averaging and flying-pixel removal): the only stage that
+// needs nothing but the pose's own frames, so a capture runs it while the table moves on. The
+// table refit that every later stage depends on needs all poses.
+struct PreparedPose {
+    DepthMap depth;
+    std::string error;  // why the frames could not be averaged (empty when they could)
+};
+
+// Returns `frames` (of a camera with `depth_unit_m`) through the first stage.
+PreparedPose PreparePose(const std::vector<DepthImage>& frames, double depth_unit_m,
+                         const MeasureConfig& config);
+
+// Returns the measurement of `session` whose poses went through PreparePose already, in pose
+// order (`session.poses` supply the angles; their frames are not read again). The same numbers
+// as MeasureSession on the same session.
+Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<PreparedPose> poses,
+                                      const MeasureConfig& config, BoxMethod method);
+
 // Returns the measurement of `session`. Refusals are results with status no_dim; the error path
 // is for an invalid configuration only.
 Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig& config,

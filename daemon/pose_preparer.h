@@ -1,0 +1,54 @@
+#pragma once
+// Overlaps processing with the capture: each pose's first pipeline stage (frame averaging and
+// flying-pixel removal) runs on a worker thread as soon as the pose is grabbed, while the table
+// moves on to the next pose. The stages after it need the table refit over all poses, so they
+// run once the capture is complete.
+
+#include <condition_variable>
+#include <deque>
+#include <mutex>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "pipeline/measure_pipeline.h"
+
+namespace boxd {
+
+class PosePreparer {
+public:
+    explicit PosePreparer(MeasureConfig config);
+    ~PosePreparer();  // stops the worker; queued poses are dropped
+    PosePreparer(const PosePreparer&) = delete;
+    PosePreparer& operator=(const PosePreparer&) = delete;
+
+    // Queues pose `index`'s raw frames (of a camera with `depth_unit_m`); returns at once.
+    void Add(std::size_t index, std::vector<DepthImage> frames, double depth_unit_m);
+
+    // Waits for the queued poses and returns every pose of `session` prepared, in pose order;
+    // a pose that was never queued is prepared now from the session's frames.
+    std::vector<PreparedPose> Finish(const Session& session);
+
+    // How many poses the worker prepared while the capture was still running (for the log).
+    int prepared_early() const { return prepared_early_; }
+
+private:
+    void Work();
+
+    struct Job {
+        std::size_t index;
+        std::vector<DepthImage> frames;
+        double depth_unit_m;
+    };
+    const MeasureConfig config_;
+    std::mutex mutex_;
+    std::condition_variable wake_;
+    std::deque<Job> queue_;
+    std::vector<std::pair<std::size_t, PreparedPose>> done_;
+    bool closing_ = false;
+    bool stop_ = false;
+    int prepared_early_ = 0;
+    std::thread worker_;
+};
+
+}  // namespace boxd
