@@ -363,44 +363,93 @@ TEST(ServeSimStation, SigtermDuringAMeasurementStopsTheTableAndExitsCleanly) {
     sim.Signal(SIGTERM);
 }
 
-// Under systemd: READY=1 once serving, WATCHDOG=1 from the loop's timer, STOPPING=1 on SIGTERM,
-// sent to a real AF_UNIX datagram socket given as NOTIFY_SOCKET.
-TEST(ServeSystemd, NotifiesReadyWatchdogAndStopping) {
-    test::TempDir dir;
-    const fs::path sock_path = dir / "notify";
-    const int fd = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-    sockaddr_un addr{};
-    addr.sun_family = AF_UNIX;
-    std::snprintf(addr.sun_path, sizeof(addr.sun_path), "%s", sock_path.c_str());
-    ASSERT_EQ(bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)), 0);
-    timeval tv{1, 0};
-    setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
-    std::vector<std::string> received;
-    auto receive_until = [&](const std::string& what, std::chrono::seconds timeout) {
+// A NOTIFY_SOCKET for the daemon: a real AF_UNIX datagram socket that collects what it sends.
+class NotifySocket {
+public:
+    explicit NotifySocket(const fs::path& path) : path_(path) {
+        fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+        sockaddr_un addr{};
+        addr.sun_family = AF_UNIX;
+        std::snprintf(addr.sun_path, sizeof(addr.sun_path), "%s", path.c_str());
+        bound_ = bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) == 0;
+        timeval tv{1, 0};
+        setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+    }
+    ~NotifySocket() { close(fd_); }
+    bool bound() const { return bound_; }
+    std::string env() const { return "NOTIFY_SOCKET=" + path_.string(); }
+    // Returns true once a message containing `what` arrives within `timeout`.
+    bool ReceiveUntil(const std::string& what, std::chrono::seconds timeout) {
         const auto deadline = Clock::now() + timeout;
         while (Clock::now() < deadline) {
             char buf[4096];
-            const ssize_t n = recv(fd, buf, sizeof(buf), 0);
+            const ssize_t n = recv(fd_, buf, sizeof(buf), 0);
             if (n <= 0) continue;
-            received.emplace_back(buf, static_cast<std::size_t>(n));
-            if (received.back().find(what) != std::string::npos) return true;
+            const std::string msg(buf, static_cast<std::size_t>(n));
+            if (msg.find(what) != std::string::npos) return true;
         }
         return false;
-    };
+    }
 
+private:
+    fs::path path_;
+    int fd_ = -1;
+    bool bound_ = false;
+};
+
+// Under systemd: READY=1 once serving, WATCHDOG=1 from the loop's timer, STOPPING=1 on SIGTERM.
+TEST(ServeSystemd, NotifiesReadyWatchdogAndStopping) {
+    test::TempDir dir;
+    NotifySocket notify(dir / "notify");
+    ASSERT_TRUE(notify.bound());
     Daemon daemon(kSimConfig, dir / "data", dir / "serve.log",
-                  {"NOTIFY_SOCKET=" + sock_path.string(), "WATCHDOG_USEC=400000"});
-    EXPECT_TRUE(receive_until("READY=1", 60s)) << ReadText(dir / "serve.log");
+                  {notify.env(), "WATCHDOG_USEC=400000"});
+    EXPECT_TRUE(notify.ReceiveUntil("READY=1", 60s)) << ReadText(dir / "serve.log");
     // READY=1 comes after the API listens.
     auto health = daemon.client().Get("/v1/health");
     ASSERT_TRUE(health);
     EXPECT_EQ(health->status, 200);
-    EXPECT_TRUE(receive_until("WATCHDOG=1", 3s));
-    EXPECT_TRUE(receive_until("WATCHDOG=1", 3s));  // and again, from the timer
+    EXPECT_TRUE(notify.ReceiveUntil("WATCHDOG=1", 3s));
+    EXPECT_TRUE(notify.ReceiveUntil("WATCHDOG=1", 3s));  // and again, from the timer
     daemon.process().Signal(SIGTERM);
-    EXPECT_TRUE(receive_until("STOPPING=1", 10s));
+    EXPECT_TRUE(notify.ReceiveUntil("STOPPING=1", 10s));
     EXPECT_EQ(daemon.process().WaitExit(10s), 0) << ReadText(dir / "serve.log");
-    close(fd);
+}
+
+// SIGHUP while idle reloads the config file (RELOADING=1, then READY=1): a changed calibration
+// is in force afterwards. A reload of a broken file keeps the running config and the daemon
+// keeps serving.
+TEST(ServeSystemd, SighupReloadsTheConfigAndSurvivesABrokenOne) {
+    test::TempDir dir;
+    NotifySocket notify(dir / "notify");
+    ASSERT_TRUE(notify.bound());
+    const fs::path config = dir / "station.yaml";
+    YAML::Node yaml = YAML::LoadFile(kSimConfig.string());
+    WriteYaml(yaml, config);
+    Daemon daemon(config, dir / "data", dir / "serve.log", {notify.env()});
+    ASSERT_TRUE(notify.ReceiveUntil("READY=1", 60s)) << ReadText(dir / "serve.log");
+    const json before = daemon.GetJson("/v1/calibration");
+    ASSERT_TRUE(before.contains("table_center_m")) << before.dump();
+    const double x0 = before["table_center_m"][0].get<double>();
+
+    yaml["calibration"]["table_center_m"][0] = x0 + 0.01;
+    WriteYaml(yaml, config);
+    daemon.process().Signal(SIGHUP);
+    EXPECT_TRUE(notify.ReceiveUntil("RELOADING=1", 10s)) << ReadText(dir / "serve.log");
+    EXPECT_TRUE(notify.ReceiveUntil("READY=1", 30s)) << ReadText(dir / "serve.log");
+    const json after = daemon.GetJson("/v1/calibration");
+    EXPECT_NEAR(after["table_center_m"][0].get<double>(), x0 + 0.01, 1e-9) << after.dump();
+
+    yaml["capture"]["poses"] = "many";
+    WriteYaml(yaml, config);
+    daemon.process().Signal(SIGHUP);
+    EXPECT_TRUE(notify.ReceiveUntil("READY=1", 30s)) << ReadText(dir / "serve.log");
+    const json kept = daemon.GetJson("/v1/calibration");
+    EXPECT_NEAR(kept["table_center_m"][0].get<double>(), x0 + 0.01, 1e-9) << kept.dump();
+    EXPECT_NE(ReadText(dir / "serve.log").find("capture.poses"), std::string::npos);
+    EXPECT_EQ(daemon.GetJson("/v1/status")["state"], "idle");
+    daemon.process().Signal(SIGTERM);
+    EXPECT_EQ(daemon.process().WaitExit(10s), 0) << ReadText(dir / "serve.log");
 }
 
 }  // namespace
