@@ -40,7 +40,10 @@ build() {
     local werror=OFF
     [ "${CI:-}" = "true" ] && werror=ON
     cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DBOXD_WERROR="$werror"
-    cmake --build "$BUILD_DIR" -j "$JOBS"
+    # Targets as arguments (the demo needs only boxd); none builds everything, tests included.
+    local targets=()
+    for t in "$@"; do targets+=(--target "$t"); done
+    cmake --build "$BUILD_DIR" -j "$JOBS" "${targets[@]}"
 }
 
 demo() {
@@ -71,7 +74,7 @@ run_tests() {
 }
 
 case "${1:-}" in
-    demo) deps; build; demo ;;
+    demo) deps; build boxd; demo ;;
     test) deps; build; run_tests ;;
     deps) deps ;;
     build) build ;;
