@@ -81,7 +81,10 @@ TEST_P(RecoversInjectedErrors, CentreAxisAndDepthOffset) {
 INSTANTIATE_TEST_SUITE_P(Seeds, RecoversInjectedErrors,
                          ::testing::Values(Injected{11, 0.01, 1.0, 0.010},
                                            Injected{12, 0.02, 2.0, -0.010},
-                                           Injected{13, 0.03, 3.0, 0.006}));
+                                           Injected{13, 0.03, 3.0, 0.006}),
+                         [](const ::testing::TestParamInfo<Injected>& info) {
+                             return "seed" + std::to_string(info.param.seed);
+                         });
 
 }  // namespace
 }  // namespace boxd

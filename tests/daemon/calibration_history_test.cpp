@@ -3,14 +3,8 @@
 // refused or not, appears in GET /v1/calibration's "history", newest first, across a restart.
 #include "daemon/calibration_history.h"
 
-#include <fcntl.h>
 #include <gtest/gtest.h>
 #include <httplib.h>
-#include <netinet/in.h>
-#include <signal.h>
-#include <sys/socket.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
 #include <fstream>
@@ -19,6 +13,7 @@
 #include <thread>
 #include <vector>
 
+#include "tests/support/serve_daemon.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd {
@@ -28,8 +23,6 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
-
-const fs::path kSimConfig = fs::path(BOXD_SOURCE_DIR) / "config" / "sim.yaml";
 
 CalibrationRecord Refused(const std::string& at, const std::string& code) {
     CalibrationRecord r;
@@ -100,89 +93,13 @@ TEST(CalibrationHistoryStore, KeepsOnlyTheLatest) {
     EXPECT_EQ(list->back()["finished_at"], "1005");
 }
 
-// Returns a TCP port that was free a moment ago on 127.0.0.1.
-int FreePort() {
-    const int fd = socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in addr{};
-    addr.sin_family = AF_INET;
-    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr));
-    socklen_t len = sizeof(addr);
-    getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-    close(fd);
-    return ntohs(addr.sin_port);
-}
+using test::ReadText;
 
-std::string ReadText(const fs::path& p) {
-    std::ifstream in(p);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-// `boxd serve` on the simulated station with its own port and data folder; stderr to `log`.
-// SIGTERM and a wait on destruction.
-class Daemon {
+// `boxd serve` on the simulated station.
+class Daemon : public test::ServeDaemon {
 public:
     Daemon(const fs::path& data_dir, const fs::path& log)
-        : port_(FreePort()), client_("127.0.0.1", port_) {
-        const std::vector<std::string> argv = {BOXD_BINARY,  "serve",
-                                               "--config",   kSimConfig.string(),
-                                               "--listen",   "127.0.0.1:" + std::to_string(port_),
-                                               "--data-dir", data_dir.string()};
-        pid_ = fork();
-        if (pid_ == 0) {
-            const int err = open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-            const int null_fd = open("/dev/null", O_RDWR);
-            dup2(null_fd, 0);
-            dup2(null_fd, 1);
-            dup2(err, 2);
-            std::vector<char*> args;
-            for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-            args.push_back(nullptr);
-            execv(args[0], args.data());
-            _exit(127);
-        }
-        client_.set_read_timeout(300, 0);
-        client_.set_connection_timeout(2, 0);
-    }
-    ~Daemon() {
-        if (pid_ <= 0) return;
-        kill(pid_, SIGTERM);
-        const auto deadline = Clock::now() + 20s;
-        while (waitpid(pid_, nullptr, WNOHANG) != pid_) {
-            if (Clock::now() > deadline) {
-                kill(pid_, SIGKILL);
-                waitpid(pid_, nullptr, 0);
-                break;
-            }
-            std::this_thread::sleep_for(20ms);
-        }
-    }
-    Daemon(const Daemon&) = delete;
-    Daemon& operator=(const Daemon&) = delete;
-
-    httplib::Client& client() { return client_; }
-    bool WaitHealthy() {
-        const auto deadline = Clock::now() + 60s;
-        while (Clock::now() < deadline) {
-            if (auto res = client_.Get("/v1/health"); res && res->status == 200) return true;
-            if (waitpid(pid_, nullptr, WNOHANG) == pid_) {
-                pid_ = -1;
-                return false;
-            }
-            std::this_thread::sleep_for(50ms);
-        }
-        return false;
-    }
-    json GetJson(const std::string& path) {
-        auto res = client_.Get(path);
-        if (!res) return json{{"transport_error", httplib::to_string(res.error())}};
-        return json::parse(res->body, nullptr, false);
-    }
-
-private:
-    int port_;
-    pid_t pid_ = -1;
-    httplib::Client client_;
+        : ServeDaemon(test::SimConfigPath(), data_dir, log) {}
 };
 
 // config/sim.yaml's box is 0.455 x 0.33 x 0.46 m.

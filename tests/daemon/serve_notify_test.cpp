@@ -2,46 +2,18 @@
 // NOTIFY_SOCKET.
 #include <gtest/gtest.h>
 #include <stdlib.h>
-#include <sys/socket.h>
-#include <sys/un.h>
-#include <unistd.h>
 
 #include <optional>
 #include <string>
 
 #include "daemon/systemd_notifier.h"
+#include "tests/support/serve_daemon.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd {
 namespace {
 
-// A bound datagram socket, like the one systemd listens on.
-class NotifySocket {
-public:
-    explicit NotifySocket(const std::filesystem::path& path) : path_(path) {
-        fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-        sockaddr_un addr{};
-        addr.sun_family = AF_UNIX;
-        std::snprintf(addr.sun_path, sizeof(addr.sun_path), "%s", path.c_str());
-        bound_ = bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) == 0;
-        timeval tv{2, 0};
-        setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
-    }
-    ~NotifySocket() { close(fd_); }
-    bool bound() const { return bound_; }
-    // Returns the next datagram, or nullopt after the receive timeout.
-    std::optional<std::string> Receive() {
-        char buf[4096];
-        const ssize_t n = recv(fd_, buf, sizeof(buf), 0);
-        if (n < 0) return std::nullopt;
-        return std::string(buf, static_cast<std::size_t>(n));
-    }
-
-private:
-    std::filesystem::path path_;
-    int fd_ = -1;
-    bool bound_ = false;
-};
+using test::NotifySocket;
 
 class SystemdNotifierTest : public ::testing::Test {
 protected:

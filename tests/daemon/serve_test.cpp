@@ -1,16 +1,9 @@
 // `boxd serve` as a real process on the simulated station (config/sim.yaml): real TCP sockets
 // (httplib::Client), a real SQLite data folder, real signals, and for the turntable a real
 // `boxd sim-turntable` whose registers the test reads over Modbus TCP with libmodbus.
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <httplib.h>
 #include <modbus/modbus.h>
-#include <netinet/in.h>
 #include <signal.h>
-#include <sys/socket.h>
-#include <sys/un.h>
-#include <sys/wait.h>
-#include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <chrono>
@@ -22,6 +15,7 @@
 #include <vector>
 
 #include "tests/support/run_command.h"
+#include "tests/support/serve_daemon.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd {
@@ -32,112 +26,12 @@ using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
-const fs::path kSimConfig = fs::path(BOXD_SOURCE_DIR) / "config" / "sim.yaml";
+const fs::path kSimConfig = test::SimConfigPath();
 
-// Returns a TCP port that was free a moment ago on 127.0.0.1.
-int FreePort() {
-    const int fd = socket(AF_INET, SOCK_STREAM, 0);
-    sockaddr_in addr{};
-    addr.sin_family = AF_INET;
-    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-    bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr));
-    socklen_t len = sizeof(addr);
-    getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
-    close(fd);
-    return ntohs(addr.sin_port);
-}
-
-std::string ReadText(const fs::path& p) {
-    std::ifstream in(p);
-    return std::string(std::istreambuf_iterator<char>(in), {});
-}
-
-// A child process started with `argv` and `env` additions; stderr goes to `log`.
-class Process {
-public:
-    Process(const std::vector<std::string>& argv, const fs::path& log,
-            const std::vector<std::string>& env = {}) {
-        pid_ = fork();
-        if (pid_ == 0) {
-            const int err = open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-            const int null_fd = open("/dev/null", O_RDWR);
-            dup2(null_fd, 0);
-            dup2(null_fd, 1);
-            dup2(err, 2);
-            for (const auto& e : env) putenv(const_cast<char*>(e.c_str()));
-            std::vector<char*> args;
-            for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-            args.push_back(nullptr);
-            execv(args[0], args.data());
-            _exit(127);
-        }
-    }
-    ~Process() {
-        if (pid_ > 0 && !exited_) {
-            kill(pid_, SIGKILL);
-            waitpid(pid_, nullptr, 0);
-        }
-    }
-    pid_t pid() const { return pid_; }
-    void Signal(int sig) { kill(pid_, sig); }
-    // Returns the exit code (128 + signal when killed), or nullopt if still running at `timeout`.
-    std::optional<int> WaitExit(std::chrono::milliseconds timeout) {
-        const auto deadline = Clock::now() + timeout;
-        while (true) {
-            int status = 0;
-            if (waitpid(pid_, &status, WNOHANG) == pid_) {
-                exited_ = true;
-                return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-            }
-            if (Clock::now() > deadline) return std::nullopt;
-            std::this_thread::sleep_for(10ms);
-        }
-    }
-
-private:
-    pid_t pid_ = -1;
-    bool exited_ = false;
-};
-
-// A `boxd serve` process on `config` with its own port and data folder.
-class Daemon {
-public:
-    Daemon(const fs::path& config, const fs::path& data_dir, const fs::path& log,
-           const std::vector<std::string>& env = {})
-        : port_(FreePort()),
-          process_({BOXD_BINARY, "serve", "--config", config.string(), "--listen",
-                    "127.0.0.1:" + std::to_string(port_), "--data-dir", data_dir.string()},
-                   log, env),
-          client_("127.0.0.1", port_) {
-        client_.set_read_timeout(180, 0);
-        client_.set_connection_timeout(2, 0);
-    }
-    httplib::Client& client() { return client_; }
-    Process& process() { return process_; }
-    int port() const { return port_; }
-
-    // Returns true once GET /v1/health answers 200 (the daemon has opened its devices and
-    // announced readiness by then).
-    bool WaitHealthy(std::chrono::seconds timeout = 60s) {
-        const auto deadline = Clock::now() + timeout;
-        while (Clock::now() < deadline) {
-            if (auto res = client_.Get("/v1/health"); res && res->status == 200) return true;
-            if (process_.WaitExit(0ms)) return false;
-            std::this_thread::sleep_for(50ms);
-        }
-        return false;
-    }
-    json GetJson(const std::string& path) {
-        auto res = client_.Get(path);
-        if (!res) return json{{"transport_error", httplib::to_string(res.error())}};
-        return json::parse(res->body, nullptr, false);
-    }
-
-private:
-    int port_;
-    Process process_;
-    httplib::Client client_;
-};
+using test::ChildProcess;
+using test::NotifySocket;
+using test::ReadText;
+using Daemon = test::ServeDaemon;
 
 // Reads holding registers [addr, addr + n) of the Modbus TCP server on 127.0.0.1:port.
 std::optional<std::vector<uint16_t>> ReadRegisters(int port, int addr, int n) {
@@ -298,9 +192,9 @@ TEST(ServeSimStation, MeasuresTheSimulatedBoxAndServesItAcrossKill9) {
 TEST(ServeSimStation, SigtermDuringAMeasurementStopsTheTableAndExitsCleanly) {
     test::TempDir dir;
     const fs::path port_file = dir / "sim.port";
-    Process sim({BOXD_BINARY, "sim-turntable", "--port", "0", "--port-file", port_file.string(),
-                 "--speed-dps", "15"},
-                dir / "sim.log");
+    ChildProcess sim({BOXD_BINARY, "sim-turntable", "--port", "0", "--port-file",
+                      port_file.string(), "--speed-dps", "15"},
+                     dir / "sim.log");
     int sim_port = 0;
     for (int i = 0; i < 500 && sim_port == 0; ++i) {
         std::ifstream(port_file) >> sim_port;
@@ -362,40 +256,6 @@ TEST(ServeSimStation, SigtermDuringAMeasurementStopsTheTableAndExitsCleanly) {
     EXPECT_EQ(aborted["reason"]["code"], "ABORTED") << aborted.dump();
     sim.Signal(SIGTERM);
 }
-
-// A NOTIFY_SOCKET for the daemon: a real AF_UNIX datagram socket that collects what it sends.
-class NotifySocket {
-public:
-    explicit NotifySocket(const fs::path& path) : path_(path) {
-        fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
-        sockaddr_un addr{};
-        addr.sun_family = AF_UNIX;
-        std::snprintf(addr.sun_path, sizeof(addr.sun_path), "%s", path.c_str());
-        bound_ = bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) == 0;
-        timeval tv{1, 0};
-        setsockopt(fd_, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
-    }
-    ~NotifySocket() { close(fd_); }
-    bool bound() const { return bound_; }
-    std::string env() const { return "NOTIFY_SOCKET=" + path_.string(); }
-    // Returns true once a message containing `what` arrives within `timeout`.
-    bool ReceiveUntil(const std::string& what, std::chrono::seconds timeout) {
-        const auto deadline = Clock::now() + timeout;
-        while (Clock::now() < deadline) {
-            char buf[4096];
-            const ssize_t n = recv(fd_, buf, sizeof(buf), 0);
-            if (n <= 0) continue;
-            const std::string msg(buf, static_cast<std::size_t>(n));
-            if (msg.find(what) != std::string::npos) return true;
-        }
-        return false;
-    }
-
-private:
-    fs::path path_;
-    int fd_ = -1;
-    bool bound_ = false;
-};
 
 // Under systemd: READY=1 once serving, WATCHDOG=1 from the loop's timer, STOPPING=1 on SIGTERM.
 TEST(ServeSystemd, NotifiesReadyWatchdogAndStopping) {

@@ -16,6 +16,7 @@
 #include "drivers/station_config.h"
 #include "pipeline/session_io.h"
 #include "pipeline/synthetic_station.h"
+#include "tests/support/child_process.h"
 #include "tests/support/run_command.h"
 #include "tests/support/temp_dir.h"
 
@@ -24,37 +25,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using test::RunBoxd;
-
-// `boxd sim-turntable` as a child process on a free loopback port.
-class SimTurntableChild {
-public:
-    explicit SimTurntableChild(const fs::path& dir) {
-        const fs::path port_file = dir / "sim.port";
-        pid_ = fork();
-        if (pid_ == 0) {
-            execl(BOXD_BINARY, BOXD_BINARY, "sim-turntable", "--port", "0", "--port-file",
-                  port_file.c_str(), "--speed-dps", "720", "--settle-ms", "20",
-                  static_cast<char*>(nullptr));
-            _exit(127);
-        }
-        for (int i = 0; i < 500 && port_ <= 0; ++i) {
-            std::ifstream in(port_file);
-            if (!(in >> port_)) port_ = 0;
-            if (port_ <= 0) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-        }
-    }
-    ~SimTurntableChild() {
-        if (pid_ > 0) {
-            kill(pid_, SIGTERM);
-            waitpid(pid_, nullptr, 0);
-        }
-    }
-    int port() const { return port_; }
-
-private:
-    pid_t pid_ = -1;
-    int port_ = 0;
-};
 
 // The scene both `boxd record` (through the config) and `boxd synth` (through flags) render.
 constexpr double kLength = 0.40, kWidth = 0.30, kHeight = 0.25;
@@ -105,7 +75,7 @@ DepthStats Stats(const DepthImage& image, double unit) {
 
 TEST(BoxdRecord, SimulatedStationMatchesSynthOfTheSameScene) {
     test::TempDir dir;
-    SimTurntableChild sim(dir.path());
+    test::SimTurntableProcess sim({"--speed-dps", "720", "--settle-ms", "20"});
     ASSERT_GT(sim.port(), 0) << "boxd sim-turntable did not start";
     std::ofstream(dir / "station.yaml") << StationYaml(sim.port());
 
@@ -165,7 +135,7 @@ fs::path CalibratedStationYaml(const fs::path& dir, int port) {
 
 TEST(BoxdRecord, RecordedSessionMeasuresLikeSynth) {
     test::TempDir dir;
-    SimTurntableChild sim(dir.path());
+    test::SimTurntableProcess sim({"--speed-dps", "720", "--settle-ms", "20"});
     ASSERT_GT(sim.port(), 0);
     const fs::path station = CalibratedStationYaml(dir.path(), sim.port());
     ASSERT_FALSE(station.empty());

@@ -1,23 +1,17 @@
 #pragma once
-// Test fixture helpers for the turntable tests: runs the real `boxd sim-turntable` binary as a
-// child process (killed when the object goes away), a test driver config that keeps the suite
-// fast, and raw register access to the simulator. Header-only: tests/CMake builds only
-// *_test.cpp files.
+// Test fixture helpers for the turntable tests: the real `boxd sim-turntable` binary as a child
+// process (tests/support/child_process.h), a test driver config that keeps the suite fast, and
+// raw register access to the simulator. Header-only: tests/CMake builds only *_test.cpp files.
 
 #include <gtest/gtest.h>
-#include <signal.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <chrono>
-#include <filesystem>
-#include <fstream>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "drivers/modbus_client.h"
 #include "drivers/turntable.h"
+#include "tests/support/child_process.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd::test {
@@ -27,90 +21,6 @@ using SteadyClock = std::chrono::steady_clock;
 inline double SecondsSince(SteadyClock::time_point start) {
     return std::chrono::duration<double>(SteadyClock::now() - start).count();
 }
-
-// A child process running `argv`; SIGTERM then SIGKILL when the object goes away.
-class ChildProcess {
-public:
-    explicit ChildProcess(const std::vector<std::string>& argv) {
-        pid_ = fork();
-        if (pid_ == 0) {
-            std::vector<char*> args;
-            for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-            args.push_back(nullptr);
-            execvp(args[0], args.data());
-            _exit(127);
-        }
-    }
-    ~ChildProcess() { Terminate(); }
-    ChildProcess(const ChildProcess&) = delete;
-    ChildProcess& operator=(const ChildProcess&) = delete;
-
-    pid_t pid() const { return pid_; }
-
-    // Returns true while the child has not exited.
-    bool Running() {
-        if (exited_) return false;
-        int status = 0;
-        if (waitpid(pid_, &status, WNOHANG) == pid_) Reap(status);
-        return !exited_;
-    }
-
-    // Sends SIGTERM and returns the exit code (128 + signal if killed), SIGKILL after
-    // `grace_ms`.
-    int Terminate(int grace_ms = 2000) {
-        if (pid_ <= 0) return -1;
-        if (!Running()) return exit_code_;
-        kill(pid_, SIGTERM);
-        const auto start = SteadyClock::now();
-        while (Running() && SecondsSince(start) * 1000 < grace_ms) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(5));
-        }
-        if (Running()) {
-            kill(pid_, SIGKILL);
-            int status = 0;
-            waitpid(pid_, &status, 0);
-            Reap(status);
-        }
-        return exit_code_;
-    }
-
-private:
-    void Reap(int status) {
-        exited_ = true;
-        exit_code_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-    }
-
-    pid_t pid_ = -1;
-    bool exited_ = false;
-    int exit_code_ = -1;
-};
-
-// `boxd sim-turntable` on a free loopback port (the simulator picks it and writes it to a
-// file, so there is no race for the port).
-class SimTurntableProcess {
-public:
-    explicit SimTurntableProcess(const std::vector<std::string>& extra_args) {
-        std::vector<std::string> argv{BOXD_BINARY, "sim-turntable", "--port",
-                                      "0",         "--port-file",   (dir_ / "port").string()};
-        argv.insert(argv.end(), extra_args.begin(), extra_args.end());
-        process_ = std::make_unique<ChildProcess>(argv);
-        const auto start = SteadyClock::now();
-        while (SecondsSince(start) < 10.0 && process_->Running()) {
-            std::ifstream in(dir_ / "port");
-            if (in >> port_) break;
-            std::this_thread::sleep_for(std::chrono::milliseconds(5));
-        }
-    }
-
-    // Returns the TCP port, or 0 if the simulator did not start.
-    int port() const { return port_; }
-    ChildProcess& process() { return *process_; }
-
-private:
-    TempDir dir_;
-    std::unique_ptr<ChildProcess> process_;
-    int port_ = 0;
-};
 
 // A driver config for the simulator: fast table, short timeouts, every wait bounded.
 inline TurntableConfig FastTestConfig(int port) {
