@@ -1,10 +1,11 @@
 #include "daemon/measurement_store.h"
 
 #include <spdlog/spdlog.h>
-#include <sqlite3.h>
 
 #include <cstdio>
 #include <regex>
+
+#include "daemon/sqlite_db.h"
 
 namespace boxd {
 
@@ -13,53 +14,7 @@ using nlohmann::json;
 
 namespace {
 
-constexpr const char* kDatabaseFile = "boxd.db";
-
 Error StorageError(const std::string& what) { return Error{kStorageErrorCode, what}; }
-
-Error SqlError(sqlite3* db, const std::string& what) {
-    return StorageError(what + ": " + sqlite3_errmsg(db));
-}
-
-// One prepared statement, finalised when it goes out of scope.
-class Statement {
-public:
-    Statement(sqlite3* db, const char* sql) {
-        rc_ = sqlite3_prepare_v2(db, sql, -1, &stmt_, nullptr);
-    }
-    ~Statement() { sqlite3_finalize(stmt_); }
-    Statement(const Statement&) = delete;
-    Statement& operator=(const Statement&) = delete;
-
-    bool prepared() const { return rc_ == SQLITE_OK; }
-    void Bind(int i, const std::string& v) {
-        sqlite3_bind_text(stmt_, i, v.c_str(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
-    }
-    void Bind(int i, long long v) { sqlite3_bind_int64(stmt_, i, v); }
-    void BindNull(int i) { sqlite3_bind_null(stmt_, i); }
-    // Returns SQLITE_ROW, SQLITE_DONE or an error code.
-    int Step() { return sqlite3_step(stmt_); }
-    std::string Text(int col) const {
-        const auto* p = sqlite3_column_text(stmt_, col);
-        return p ? reinterpret_cast<const char*>(p) : "";
-    }
-    bool IsNull(int col) const { return sqlite3_column_type(stmt_, col) == SQLITE_NULL; }
-    long long Int(int col) const { return sqlite3_column_int64(stmt_, col); }
-
-private:
-    sqlite3_stmt* stmt_ = nullptr;
-    int rc_ = SQLITE_ERROR;
-};
-
-Status Exec(sqlite3* db, const char* sql) {
-    char* err = nullptr;
-    if (sqlite3_exec(db, sql, nullptr, nullptr, &err) != SQLITE_OK) {
-        Error e = StorageError(std::string(sql).substr(0, 40) + "...: " + (err ? err : "?"));
-        sqlite3_free(err);
-        return e;
-    }
-    return OkStatus();
-}
 
 // Ids are "m-" and at least six digits; anything else never reaches SQL or the file system.
 bool IsValidId(const std::string& id) {
@@ -109,41 +64,23 @@ Result<std::unique_ptr<MeasurementStore>> MeasurementStore::Open(const fs::path&
         fs::remove_all(entry.path(), rm);
     }
 
-    sqlite3* db = nullptr;
-    const fs::path db_path = data_dir / kDatabaseFile;
-    if (sqlite3_open_v2(db_path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE,
-                        nullptr) != SQLITE_OK) {
-        Error e = SqlError(db, "cannot open " + db_path.string());
-        sqlite3_close(db);
-        return e;
-    }
-    std::unique_ptr<MeasurementStore> store(new MeasurementStore(data_dir, db, retention));
-    sqlite3_busy_timeout(db, 5000);
-    // WAL keeps readers and the writer apart; synchronous=FULL makes each commit durable across
-    // power loss too, which costs nothing at one measurement every few seconds.
-    for (const char* sql : {
-             "PRAGMA journal_mode=WAL;",
-             "PRAGMA synchronous=FULL;",
-             "CREATE TABLE IF NOT EXISTS measurements ("
-             "  seq INTEGER PRIMARY KEY,"
-             "  id TEXT NOT NULL UNIQUE,"
-             "  started_at TEXT NOT NULL,"
-             "  finished_at TEXT NOT NULL,"
-             "  status TEXT NOT NULL,"
-             "  result_json TEXT NOT NULL,"
-             "  cloud_file TEXT,"
-             "  session_dir TEXT);",
-             "CREATE TABLE IF NOT EXISTS id_counter ("
-             "  one INTEGER PRIMARY KEY CHECK (one = 1),"
-             "  last_seq INTEGER NOT NULL);",
-             "INSERT OR IGNORE INTO id_counter VALUES (1, 0);",
-         }) {
-        if (auto s = Exec(db, sql); !s) return s.error();
-    }
-    Statement mode(db, "PRAGMA journal_mode;");
-    if (!mode.prepared() || mode.Step() != SQLITE_ROW || mode.Text(0) != "wal") {
-        return StorageError(db_path.string() + ": cannot switch to WAL mode");
-    }
+    auto db = OpenDatabase(data_dir, {
+                                         "CREATE TABLE IF NOT EXISTS measurements ("
+                                         "  seq INTEGER PRIMARY KEY,"
+                                         "  id TEXT NOT NULL UNIQUE,"
+                                         "  started_at TEXT NOT NULL,"
+                                         "  finished_at TEXT NOT NULL,"
+                                         "  status TEXT NOT NULL,"
+                                         "  result_json TEXT NOT NULL,"
+                                         "  cloud_file TEXT,"
+                                         "  session_dir TEXT);",
+                                         "CREATE TABLE IF NOT EXISTS id_counter ("
+                                         "  one INTEGER PRIMARY KEY CHECK (one = 1),"
+                                         "  last_seq INTEGER NOT NULL);",
+                                         "INSERT OR IGNORE INTO id_counter VALUES (1, 0);",
+                                     });
+    if (!db) return db.error();
+    std::unique_ptr<MeasurementStore> store(new MeasurementStore(data_dir, *db, retention));
     return store;
 }
 
@@ -154,23 +91,23 @@ void MeasurementStore::set_retention(int retention) {
 
 Result<std::string> MeasurementStore::ReserveId() {
     std::lock_guard lock(mutex_);
-    if (auto s = Exec(db_, "BEGIN IMMEDIATE;"); !s) return s.error();
+    if (auto s = SqlExec(db_, "BEGIN IMMEDIATE;"); !s) return s.error();
     // The counter never goes below the largest stored id, even if the counter row was lost.
-    if (auto s = Exec(db_,
-                      "UPDATE id_counter SET last_seq = 1 + max(last_seq,"
-                      " (SELECT coalesce(max(seq), 0) FROM measurements));");
+    if (auto s = SqlExec(db_,
+                         "UPDATE id_counter SET last_seq = 1 + max(last_seq,"
+                         " (SELECT coalesce(max(seq), 0) FROM measurements));");
         !s) {
-        (void)Exec(db_, "ROLLBACK;");
+        (void)SqlExec(db_, "ROLLBACK;");
         return s.error();
     }
-    Statement q(db_, "SELECT last_seq FROM id_counter;");
+    SqlStatement q(db_, "SELECT last_seq FROM id_counter;");
     if (!q.prepared() || q.Step() != SQLITE_ROW) {
         Error e = SqlError(db_, "cannot read the id counter");
-        (void)Exec(db_, "ROLLBACK;");
+        (void)SqlExec(db_, "ROLLBACK;");
         return e;
     }
     const long long seq = q.Int(0);
-    if (auto s = Exec(db_, "COMMIT;"); !s) return s.error();
+    if (auto s = SqlExec(db_, "COMMIT;"); !s) return s.error();
     char id[32];
     std::snprintf(id, sizeof(id), "m-%06lld", seq);
     return std::string(id);
@@ -208,10 +145,10 @@ Status MeasurementStore::Save(const json& result, const MeasurementFiles& files)
         if (auto s = MoveInto(*files.session_dir, data_dir_ / *session_dir); !s) return s;
     }
 
-    Statement insert(db_,
-                     "INSERT OR REPLACE INTO measurements (seq, id, started_at, finished_at,"
-                     " status, result_json, cloud_file, session_dir)"
-                     " VALUES (?, ?, ?, ?, ?, ?, ?, ?);");
+    SqlStatement insert(db_,
+                        "INSERT OR REPLACE INTO measurements (seq, id, started_at, finished_at,"
+                        " status, result_json, cloud_file, session_dir)"
+                        " VALUES (?, ?, ?, ?, ?, ?, ?, ?);");
     if (!insert.prepared()) return SqlError(db_, "cannot prepare the insert");
     insert.Bind(1, seq);
     insert.Bind(2, id);
@@ -231,18 +168,18 @@ Status MeasurementStore::ApplyRetentionLocked() {
     };
     std::vector<Doomed> doomed;
     {
-        Statement q(db_,
-                    "SELECT id, cloud_file, session_dir FROM measurements"
-                    " ORDER BY seq DESC LIMIT -1 OFFSET ?;");
+        SqlStatement q(db_,
+                       "SELECT id, cloud_file, session_dir FROM measurements"
+                       " ORDER BY seq DESC LIMIT -1 OFFSET ?;");
         if (!q.prepared()) return SqlError(db_, "cannot prepare the retention query");
         q.Bind(1, static_cast<long long>(retention_));
         while (q.Step() == SQLITE_ROW) doomed.push_back({q.Text(0), q.Text(1), q.Text(2)});
     }
     if (doomed.empty()) return OkStatus();
     {
-        Statement del(db_,
-                      "DELETE FROM measurements WHERE seq IN (SELECT seq FROM measurements"
-                      " ORDER BY seq DESC LIMIT -1 OFFSET ?);");
+        SqlStatement del(db_,
+                         "DELETE FROM measurements WHERE seq IN (SELECT seq FROM measurements"
+                         " ORDER BY seq DESC LIMIT -1 OFFSET ?);");
         if (!del.prepared()) return SqlError(db_, "cannot prepare the retention delete");
         del.Bind(1, static_cast<long long>(retention_));
         if (del.Step() != SQLITE_DONE) return SqlError(db_, "cannot apply the retention limit");
@@ -259,7 +196,7 @@ Status MeasurementStore::ApplyRetentionLocked() {
 
 Result<std::optional<json>> MeasurementStore::Last() {
     std::lock_guard lock(mutex_);
-    Statement q(db_, "SELECT id, result_json FROM measurements ORDER BY seq DESC LIMIT 1;");
+    SqlStatement q(db_, "SELECT id, result_json FROM measurements ORDER BY seq DESC LIMIT 1;");
     if (!q.prepared()) return SqlError(db_, "cannot prepare a query");
     const int rc = q.Step();
     if (rc == SQLITE_DONE) return std::optional<json>();
@@ -270,7 +207,7 @@ Result<std::optional<json>> MeasurementStore::Last() {
 Result<std::optional<json>> MeasurementStore::Get(const std::string& id) {
     if (!IsValidId(id)) return std::optional<json>();
     std::lock_guard lock(mutex_);
-    Statement q(db_, "SELECT result_json FROM measurements WHERE id = ?;");
+    SqlStatement q(db_, "SELECT result_json FROM measurements WHERE id = ?;");
     if (!q.prepared()) return SqlError(db_, "cannot prepare a query");
     q.Bind(1, id);
     const int rc = q.Step();
@@ -281,7 +218,7 @@ Result<std::optional<json>> MeasurementStore::Get(const std::string& id) {
 
 Result<std::vector<json>> MeasurementStore::List(int limit) {
     std::lock_guard lock(mutex_);
-    Statement q(db_, "SELECT id, result_json FROM measurements ORDER BY seq DESC LIMIT ?;");
+    SqlStatement q(db_, "SELECT id, result_json FROM measurements ORDER BY seq DESC LIMIT ?;");
     if (!q.prepared()) return SqlError(db_, "cannot prepare a query");
     q.Bind(1, static_cast<long long>(limit));
     std::vector<json> out;
@@ -298,7 +235,7 @@ Result<std::vector<json>> MeasurementStore::List(int limit) {
 Result<std::optional<fs::path>> MeasurementStore::CloudPath(const std::string& id) {
     if (!IsValidId(id)) return std::optional<fs::path>();
     std::lock_guard lock(mutex_);
-    Statement q(db_, "SELECT cloud_file FROM measurements WHERE id = ?;");
+    SqlStatement q(db_, "SELECT cloud_file FROM measurements WHERE id = ?;");
     if (!q.prepared()) return SqlError(db_, "cannot prepare a query");
     q.Bind(1, id);
     const int rc = q.Step();
@@ -309,7 +246,7 @@ Result<std::optional<fs::path>> MeasurementStore::CloudPath(const std::string& i
 
 Result<int> MeasurementStore::Count() {
     std::lock_guard lock(mutex_);
-    Statement q(db_, "SELECT count(*) FROM measurements;");
+    SqlStatement q(db_, "SELECT count(*) FROM measurements;");
     if (!q.prepared() || q.Step() != SQLITE_ROW) return SqlError(db_, "cannot count");
     return static_cast<int>(q.Int(0));
 }
