@@ -153,76 +153,74 @@ TEST(CliCalibrate, CalibratesAndTheCalibrationMakesOtherBoxesMeasureRight) {
     EXPECT_LT(before[2], truth_dims[2] - 0.001);
 }
 
+// Renders a session with `synth_args` (after --out), calibrates it against `reference` and
+// returns what `boxd calibrate` answered; a refusal is exit 2, nothing on stdout and its code on
+// stderr.
+test::CommandOutput CalibrateSynth(const test::TempDir& dir,
+                                   const std::vector<std::string>& synth_args,
+                                   const std::vector<std::string>& reference) {
+    std::vector<std::string> synth{"synth", "--out", (dir / "s").string()};
+    synth.insert(synth.end(), synth_args.begin(), synth_args.end());
+    const auto rendered = RunBoxd(synth);
+    EXPECT_EQ(rendered.exit_code, 0) << rendered.err;
+    std::vector<std::string> calibrate{"calibrate", "--session", (dir / "s").string(),
+                                       "--reference"};
+    calibrate.insert(calibrate.end(), reference.begin(), reference.end());
+    return RunBoxd(calibrate);
+}
+
+void ExpectRefused(const test::CommandOutput& r, const std::string& code) {
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find(code), std::string::npos) << r.err;
+    EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
 TEST(CliCalibrate, RefusesTooFewPoses) {
     test::TempDir dir;
-    ASSERT_EQ(RunBoxd({"synth", "--out", (dir / "s").string(), "--dims", "0.3", "0.3", "0.3",
-                       "--poses", "3", "--frames", "1"})
-                  .exit_code,
-              0);
-    const auto r = RunBoxd(
-        {"calibrate", "--session", (dir / "s").string(), "--reference", "0.3", "0.3", "0.3"});
-    EXPECT_EQ(r.exit_code, 2);
-    EXPECT_NE(r.err.find("TOO_FEW_POSES"), std::string::npos) << r.err;
-    EXPECT_TRUE(r.out.empty());
+    ExpectRefused(
+        CalibrateSynth(dir, {"--dims", "0.3", "0.3", "0.3", "--poses", "3", "--frames", "1"},
+                       {"0.3", "0.3", "0.3"}),
+        "TOO_FEW_POSES");
 }
 
 TEST(CliCalibrate, RefusesAWrongReferenceBox) {
     test::TempDir dir;
-    ASSERT_EQ(RunBoxd({"synth", "--out", (dir / "s").string(), "--dims", "0.3", "0.25", "0.3",
-                       "--poses", "8", "--frames", "1"})
-                  .exit_code,
-              0);
-    const auto r = RunBoxd(
-        {"calibrate", "--session", (dir / "s").string(), "--reference", "0.4", "0.25", "0.3"});
-    EXPECT_EQ(r.exit_code, 2);
-    EXPECT_NE(r.err.find("WRONG_REFERENCE"), std::string::npos) << r.err;
+    ExpectRefused(
+        CalibrateSynth(dir, {"--dims", "0.3", "0.25", "0.3", "--poses", "8", "--frames", "1"},
+                       {"0.4", "0.25", "0.3"}),
+        "WRONG_REFERENCE");
 }
 
+// The views before and after the push show the box in two places: their alignments disagree
+// with each other and with the turntable motion.
 TEST(CliCalibrate, RefusesWhenTheBoxMoved) {
     test::TempDir dir;
-    ASSERT_EQ(
-        RunBoxd({"synth", "--out", (dir / "s").string(), "--dims", "0.3", "0.25", "0.3", "--poses",
-                 "8", "--frames", "1", "--move-at-pose", "4", "--move-by", "0.05", "0.0", "10"})
-            .exit_code,
-        0);
-    const auto r = RunBoxd(
-        {"calibrate", "--session", (dir / "s").string(), "--reference", "0.3", "0.25", "0.3"});
-    EXPECT_EQ(r.exit_code, 2);
-    // The views before and after the push show the box in two places: their alignments
-    // disagree with each other and with the turntable motion.
-    EXPECT_NE(r.err.find("BOX_MOVED"), std::string::npos) << r.err;
-    EXPECT_TRUE(r.out.empty());
+    ExpectRefused(CalibrateSynth(dir,
+                                 {"--dims", "0.3", "0.25", "0.3", "--poses", "8", "--frames", "1",
+                                  "--move-at-pose", "4", "--move-by", "0.05", "0.0", "10"},
+                                 {"0.3", "0.25", "0.3"}),
+                  "BOX_MOVED");
 }
 
+// Nothing stands on the table: a 1 mm sheet of card lies on it, below the height at which the
+// pipeline tells an object from the table top (8 mm).
 TEST(CliCalibrate, RefusesAnEmptyTable) {
     test::TempDir dir;
-    // Nothing stands on the table: a 1 mm sheet of card lies on it, below the height at which
-    // the pipeline tells an object from the table top (8 mm).
-    ASSERT_EQ(RunBoxd({"synth", "--out", (dir / "s").string(), "--dims", "0.3", "0.25", "0.001",
-                       "--poses", "8", "--frames", "1"})
-                  .exit_code,
-              0);
-    const auto r = RunBoxd(
-        {"calibrate", "--session", (dir / "s").string(), "--reference", "0.3", "0.25", "0.3"});
-    EXPECT_EQ(r.exit_code, 2);
-    EXPECT_NE(r.err.find("NO_REFERENCE"), std::string::npos) << r.err;
-    EXPECT_TRUE(r.out.empty());
+    ExpectRefused(
+        CalibrateSynth(dir, {"--dims", "0.3", "0.25", "0.001", "--poses", "8", "--frames", "1"},
+                       {"0.3", "0.25", "0.3"}),
+        "NO_REFERENCE");
 }
 
+// Stated 24 mm (8%) taller than the box: within the 10% that tells a wrong box, but no centre,
+// axis and depth offset make the views show a box of that size, so the joint fit leaves the
+// faces far from the model instead of bending the calibration to it.
 TEST(CliCalibrate, RefusesWhenNoGeometryFitsTheStatedReference) {
     test::TempDir dir;
-    ASSERT_EQ(RunBoxd({"synth", "--out", (dir / "s").string(), "--dims", "0.3", "0.25", "0.3",
-                       "--poses", "8", "--frames", "1"})
-                  .exit_code,
-              0);
-    // Stated 24 mm (8%) taller than the box: within the 10% that tells a wrong box, but no
-    // centre, axis and depth offset make the views show a box of that size, so the joint fit
-    // leaves the faces far from the model instead of bending the calibration to it.
-    const auto r = RunBoxd(
-        {"calibrate", "--session", (dir / "s").string(), "--reference", "0.3", "0.25", "0.324"});
-    EXPECT_EQ(r.exit_code, 2);
-    EXPECT_NE(r.err.find("NOT_CONVERGED"), std::string::npos) << r.err;
-    EXPECT_TRUE(r.out.empty());
+    ExpectRefused(
+        CalibrateSynth(dir, {"--dims", "0.3", "0.25", "0.3", "--poses", "8", "--frames", "1"},
+                       {"0.3", "0.25", "0.324"}),
+        "NOT_CONVERGED");
 }
 
 TEST(CliCalibrate, RefusesWhenTheTableIsNotVisible) {
