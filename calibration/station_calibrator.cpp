@@ -123,30 +123,10 @@ Result<InitialEstimate> EstimateInitial(const Session& session, const MeasureCon
         return Error{code::kBoxMoved,
                      "the views of the reference box do not register: " + report.error().message};
     }
-    const RefusalConfig& refuse = mc.refusal;
-    if (report->max_model_yaw_deviation_rad * 180.0 / M_PI > refuse.max_model_yaw_deviation_deg ||
-        report->max_model_translation_deviation_m > refuse.max_model_translation_deviation_m) {
-        return Error{code::kBoxMoved, "the views disagree with the turntable motion (" +
-                                          Fmt("%.1f deg, %.1f mm",
-                                              report->max_model_yaw_deviation_rad * 180.0 / M_PI,
-                                              report->max_model_translation_deviation_m * 1000.0) +
-                                          "): the reference box moved on the table"};
-    }
-    // The measurement pipeline's moved-object test: when more alignments than this fraction
-    // disagree with the rest, the views show the box in two places.
-    const int graph_edges = report->rejected_edges + report->active_edges;
-    if (graph_edges > 0 &&
-        report->rejected_edges > refuse.max_rejected_edge_fraction * graph_edges) {
-        return Error{code::kBoxMoved, std::to_string(report->rejected_edges) + " of " +
-                                          std::to_string(graph_edges) +
-                                          " view alignments disagree with the others: the "
-                                          "reference box moved on the table"};
-    }
-    if (report->active_edges == 0 ||
-        report->unconstrained_nodes > refuse.max_unconstrained_fraction * n) {
-        return Error{code::kBoxMoved, "too few views of the reference box could be registered (" +
-                                          std::to_string(report->unconstrained_nodes) + " of " +
-                                          std::to_string(n) + " unregistered)"};
+    // The measurement pipeline's tests of registered views: a box that moved (or views that do
+    // not register) cannot calibrate anything.
+    if (auto why = CheckRegisteredViews(*report, n, mc.refusal)) {
+        return Error{code::kBoxMoved, "reference box: " + why->message};
     }
 
     // The centre the registered views rotate about ((I - R_k) c = t_k, least squares).

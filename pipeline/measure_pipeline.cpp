@@ -78,6 +78,35 @@ Status RefusalConfig::Validate() const {
     return OkStatus();
 }
 
+std::optional<MeasurementReason> CheckRegisteredViews(const PoseGraphReport& report, int poses,
+                                                      const RefusalConfig& refuse) {
+    if (report.max_model_yaw_deviation_rad * 180.0 / M_PI > refuse.max_model_yaw_deviation_deg ||
+        report.max_model_translation_deviation_m > refuse.max_model_translation_deviation_m) {
+        return MeasurementReason{
+            reason::kObjectMoved,
+            "the views disagree with the turntable motion (" +
+                Fmt("%.1f deg, %.1f mm", report.max_model_yaw_deviation_rad * 180.0 / M_PI,
+                    report.max_model_translation_deviation_m * 1000.0) +
+                "): the object moved on the table"};
+    }
+    const int edges = report.rejected_edges + report.active_edges;
+    if (edges > 0 && report.rejected_edges > refuse.max_rejected_edge_fraction * edges) {
+        return MeasurementReason{reason::kObjectMoved,
+                                 std::to_string(report.rejected_edges) + " of " +
+                                     std::to_string(edges) +
+                                     " view alignments disagree with the others: the object "
+                                     "moved on the table"};
+    }
+    if (report.active_edges == 0 ||
+        report.unconstrained_nodes > refuse.max_unconstrained_fraction * poses) {
+        return MeasurementReason{reason::kRegistrationFailed,
+                                 "too few views could be registered (" +
+                                     std::to_string(report.unconstrained_nodes) + " of " +
+                                     std::to_string(poses) + " unregistered)"};
+    }
+    return std::nullopt;
+}
+
 Status MeasureConfig::Validate() const {
     for (Status s : {averaging.Validate(), flying_pixels.Validate(), table_plane.Validate(),
                      segmentation.Validate(), registration.Validate(), pose_graph.Validate(),
@@ -224,31 +253,8 @@ Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<Prepar
     }
     res.quality.registration_rmse_m = edge_stats.mean_rmse_m;
     if (n > 1) {
-        if (report->max_model_yaw_deviation_rad * 180.0 / M_PI >
-                refuse.max_model_yaw_deviation_deg ||
-            report->max_model_translation_deviation_m > refuse.max_model_translation_deviation_m) {
-            return run.Refuse(
-                reason::kObjectMoved,
-                "the views disagree with the turntable motion (" +
-                    Fmt("%.1f deg, %.1f mm", report->max_model_yaw_deviation_rad * 180.0 / M_PI,
-                        report->max_model_translation_deviation_m * 1000.0) +
-                    "): the object moved on the table");
-        }
-        const int graph_edges = report->rejected_edges + report->active_edges;
-        if (graph_edges > 0 &&
-            report->rejected_edges > refuse.max_rejected_edge_fraction * graph_edges) {
-            return run.Refuse(reason::kObjectMoved,
-                              std::to_string(report->rejected_edges) + " of " +
-                                  std::to_string(graph_edges) +
-                                  " view alignments disagree with the others: the object moved "
-                                  "on the table");
-        }
-        if (report->active_edges == 0 ||
-            report->unconstrained_nodes > refuse.max_unconstrained_fraction * n) {
-            return run.Refuse(reason::kRegistrationFailed,
-                              "too few views could be registered (" +
-                                  std::to_string(report->unconstrained_nodes) + " of " +
-                                  std::to_string(n) + " unregistered)");
+        if (auto why = CheckRegisteredViews(*report, n, refuse)) {
+            return run.Refuse(why->code, why->message);
         }
         if (edge_stats.mean_rmse_m > refuse.max_registration_rmse_m) {
             return run.Refuse(

@@ -3,6 +3,7 @@
 // Stages (SPEC section 1): frame averaging, table frame and segmentation, registration (coarse
 // then fine ICP), pose-graph optimisation, fusion, box fitting, quality and refusal.
 
+#include <optional>
 #include <string>
 
 #include "pipeline/box_fit.h"
@@ -37,6 +38,13 @@ struct RefusalConfig {
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;
 };
+
+// Returns why registered views cannot be trusted, or nullopt: OBJECT_MOVED when the registered
+// poses leave the turntable model or too many alignments disagree with the rest (the views show
+// the object in two places), REGISTRATION_FAILED when too few views are registered. `report` is
+// the pose graph's over `poses` views.
+std::optional<MeasurementReason> CheckRegisteredViews(const PoseGraphReport& report, int poses,
+                                                      const RefusalConfig& refuse);
 
 struct MeasureConfig {
     AveragingConfig averaging;
