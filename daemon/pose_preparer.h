@@ -25,11 +25,11 @@ public:
     // Queues pose `index`'s raw frames (of a camera with `depth_unit_m`); returns at once.
     void Add(std::size_t index, std::vector<DepthImage> frames, double depth_unit_m);
 
-    // Waits for the queued poses and returns every pose of `session` prepared, in pose order;
-    // a pose that was never queued is prepared now from the session's frames.
+    // Returns every pose of `session` prepared, in pose order: the worker's, then what was still
+    // queued and what was never queued (from the session's frames), on config.threads threads.
     std::vector<PreparedPose> Finish(const Session& session);
 
-    // How many poses the worker prepared while the capture was still running (for the log).
+    // How many poses the worker had prepared when Finish was called (for the log).
     int prepared_early() const { return prepared_early_; }
 
 private:
@@ -45,7 +45,6 @@ private:
     std::condition_variable wake_;
     std::deque<Job> queue_;
     std::vector<std::pair<std::size_t, PreparedPose>> done_;
-    bool closing_ = false;
     bool stop_ = false;
     int prepared_early_ = 0;
     std::thread worker_;

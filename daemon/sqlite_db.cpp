@@ -40,10 +40,14 @@ Result<sqlite3*> OpenDatabase(const std::filesystem::path& data_dir,
     for (const char* sql : {"PRAGMA journal_mode=WAL;", "PRAGMA synchronous=FULL;"}) {
         if (auto s = SqlExec(db, sql); !s) return fail(s.error());
     }
-    SqlStatement mode(db, "PRAGMA journal_mode;");
-    if (!mode.prepared() || mode.Step() != SQLITE_ROW || mode.Text(0) != "wal") {
-        return fail(Error{kStorageErrorCode, path.string() + ": cannot switch to WAL mode"});
+    bool wal = false;
+    {
+        // Finalised before any close below: sqlite3_close refuses a connection with live
+        // statements.
+        SqlStatement mode(db, "PRAGMA journal_mode;");
+        wal = mode.prepared() && mode.Step() == SQLITE_ROW && mode.Text(0) == "wal";
     }
+    if (!wal) return fail(Error{kStorageErrorCode, path.string() + ": cannot switch to WAL mode"});
     for (const char* sql : schema) {
         if (auto s = SqlExec(db, sql); !s) {
             return fail(Error{kStorageErrorCode, path.string() + ": " + s.error().message});

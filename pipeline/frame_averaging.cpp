@@ -55,8 +55,7 @@ Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, doubl
     std::vector<std::uint16_t> heap(n > kStackReadings ? n : 0);
     std::array<std::uint16_t, kStackReadings> stack{};
     std::uint16_t* r = n > kStackReadings ? heap.data() : stack.data();
-    // Plain pointers: the readings buffer has the frames' element type, so reaching the pixels
-    // through the vectors would make the compiler reload them after every store.
+    // The frames' pixel arrays, looked up once instead of through the vectors for every pixel.
     std::vector<const std::uint16_t*> src(n);
     for (std::size_t f = 0; f < n; ++f) src[f] = frames[f].pixels.data();
     const std::size_t count = out.z_m.size();

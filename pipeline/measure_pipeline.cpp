@@ -135,6 +135,7 @@ Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig
                                      BoxMethod method) {
     if (Status s = config.Validate(); !s) return s.error();
     const auto start = Clock::now();
+    const std::string started_at = UtcTimestampNow();
     const int n = static_cast<int>(session.poses.size());
     std::vector<PreparedPose> prepared(static_cast<std::size_t>(n));
     ParallelFor(n, config.threads, [&](int k) {
@@ -145,6 +146,7 @@ Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig
     auto out = MeasurePrepared(session, std::move(prepared), config, method);
     if (out) {
         // The whole run, first stage included, as if it were one call.
+        out->result.started_at = started_at;
         auto& timing = out->result.timing_ms;
         timing["preprocess"] += first_stage_ms;
         timing["processing"] += first_stage_ms;

@@ -13,12 +13,15 @@ namespace boxd {
 class NearestGrid {
 public:
     NearestGrid() = default;
-    // Buckets `points` into cubic cells of edge `cell_m` (grown when the bounding box would need
-    // more than `max_cells` cells). Queries are fastest when the search radius is near cell_m.
-    NearestGrid(const Points& points, float cell_m, std::size_t max_cells = 8u << 20);
+    // Buckets `points` into cubic cells of edge `cell_m`, grown when the bounding box would need
+    // more than `max_cells` cells (0: 256 per point, at least 65536, at most 8M — the cell array
+    // is dense). Queries are fastest when the search radius is near cell_m. Points that are not
+    // finite are left out (they are nobody's neighbour).
+    NearestGrid(const Points& points, float cell_m, std::size_t max_cells = 0);
 
     // Returns the index (into the constructor's points) of the nearest point within `max_dist`
-    // of `p`, or -1. Ties go to the lower index, so the answer never depends on the layout.
+    // of `p`, or -1 (also for a query that is not finite). Ties go to the lower index, so the
+    // answer never depends on the layout.
     int Nearest(const Eigen::Vector3f& p, float max_dist) const;
 
     float cell_m() const { return cell_; }

@@ -33,9 +33,11 @@ struct RegistrationClouds {
     OrientedPoints fine;
 };
 
-// Returns both clouds of `points` from one voxel pass at the finer of the two voxels (the
-// coarser cloud regrids its weighted centroids): the same clouds, up to centroid rounding, at a
-// fraction of the cost of two BuildRegistrationCloud calls.
+// Returns both clouds of `points` from one voxel pass at the finer of the two voxels: the
+// coarser cloud, and either cloud when it has to grow its voxel to stay near max_points, regrids
+// the weighted centroids of that pass instead of the raw points. Each centroid carries its
+// voxel's whole weight into the voxel that holds it, so this approximates a direct pass (exact
+// only when the voxels nest) at a fraction of the cost.
 RegistrationClouds BuildRegistrationClouds(const Points& points,
                                            const RegistrationCloudConfig& coarse,
                                            const RegistrationCloudConfig& fine);

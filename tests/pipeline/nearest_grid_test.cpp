@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <random>
 
 namespace boxd {
@@ -45,6 +46,21 @@ TEST(NearestGrid, EmptyAndFarQueriesFindNothing) {
     EXPECT_EQ(grid.Nearest(Eigen::Vector3f(5, 5, 5), 0.01f), -1);
     EXPECT_EQ(grid.Nearest(Eigen::Vector3f(0.095f, 0, 0), 0.01f), 1);
     EXPECT_EQ(grid.Nearest(Eigen::Vector3f(0.05f, 0, 0), 0.01f), -1);
+}
+
+TEST(NearestGrid, IgnoresPointsAndQueriesThatAreNotFinite) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    const Points pts{Eigen::Vector3f(nan, 0, 0), Eigen::Vector3f(0.01f, 0, 0),
+                     Eigen::Vector3f(0, inf, 0), Eigen::Vector3f(0.02f, 0, 0)};
+    const NearestGrid grid(pts, 0.01f);
+    EXPECT_EQ(grid.Nearest(Eigen::Vector3f(0.011f, 0, 0), 0.01f), 1);
+    EXPECT_EQ(grid.Nearest(Eigen::Vector3f(0.019f, 0, 0), 0.01f), 3);
+    EXPECT_EQ(grid.Nearest(Eigen::Vector3f(nan, 0, 0), 0.01f), -1);
+    EXPECT_EQ(grid.Nearest(Eigen::Vector3f(0.01f, 0, 0), 1e30f), 1);  // a huge radius is fine
+    EXPECT_EQ(NearestGrid(Points{Eigen::Vector3f(nan, nan, nan)}, 0.01f)
+                  .Nearest(Eigen::Vector3f::Zero(), 1.0f),
+              -1);
 }
 
 TEST(NearestGrid, GrowsTheCellToBoundMemory) {

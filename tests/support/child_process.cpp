@@ -1,14 +1,17 @@
 #include "tests/support/child_process.h"
 
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <signal.h>
 #include <stdlib.h>
+#include <sys/prctl.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <fstream>
+#include <string_view>
 #include <thread>
 
 namespace boxd::test {
@@ -34,21 +37,43 @@ std::string ReadText(const std::filesystem::path& path) {
 
 ChildProcess::ChildProcess(const std::vector<std::string>& argv, const std::filesystem::path& log,
                            const std::vector<std::string>& env) {
-    pid_ = fork();
-    if (pid_ != 0) return;
-    if (!log.empty()) {
-        const int err = open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-        const int null_fd = open("/dev/null", O_RDWR);
-        dup2(null_fd, 0);
-        dup2(null_fd, 1);
-        dup2(err, 2);
-    }
-    for (const auto& e : env) putenv(const_cast<char*>(e.c_str()));
+    // Everything the child needs is built before fork: between fork and exec only
+    // async-signal-safe calls are allowed (the test process may have other threads).
     std::vector<char*> args;
     for (const auto& a : argv) args.push_back(const_cast<char*>(a.c_str()));
     args.push_back(nullptr);
-    execvp(args[0], args.data());
-    _exit(127);
+    std::vector<std::string> names;
+    for (const auto& e : env) names.push_back(e.substr(0, e.find('=') + 1));
+    std::vector<char*> envp;
+    for (char** e = environ; *e; ++e) {
+        const std::string_view entry(*e);
+        bool replaced = false;
+        for (const auto& n : names) replaced = replaced || entry.rfind(n, 0) == 0;
+        if (!replaced) envp.push_back(*e);
+    }
+    for (const auto& e : env) envp.push_back(const_cast<char*>(e.c_str()));
+    envp.push_back(nullptr);
+    const int log_fd =
+        log.empty() ? -1 : open(log.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+    const int null_fd = log.empty() ? -1 : open("/dev/null", O_RDWR | O_CLOEXEC);
+    const pid_t parent = getpid();
+
+    pid_ = fork();
+    if (pid_ == 0) {
+        // Die with the test: a test killed on timeout must not leave a daemon running.
+        prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (getppid() != parent) _exit(127);
+        if (log_fd >= 0 && null_fd >= 0) {  // dup2 clears close-on-exec on the copies
+            dup2(null_fd, 0);
+            dup2(null_fd, 1);
+            dup2(log_fd, 2);
+        }
+        execvpe(args[0], args.data(), envp.data());
+        _exit(127);
+    }
+    if (log_fd >= 0) close(log_fd);
+    if (null_fd >= 0) close(null_fd);
+    if (pid_ < 0) ADD_FAILURE() << "fork failed for " << argv.front();
 }
 
 ChildProcess::~ChildProcess() { Terminate(); }

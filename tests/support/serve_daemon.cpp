@@ -48,6 +48,7 @@ NotifySocket::NotifySocket(const std::filesystem::path& path) : path_(path) {
     fd_ = socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
     sockaddr_un addr{};
     addr.sun_family = AF_UNIX;
+    if (path.string().size() >= sizeof(addr.sun_path)) return;  // would be cut: not bound
     std::snprintf(addr.sun_path, sizeof(addr.sun_path), "%s", path.c_str());
     bound_ = bind(fd_, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) == 0;
     timeval tv{2, 0};
