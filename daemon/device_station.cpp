@@ -163,6 +163,7 @@ JobOutput DeviceStation::Measure(const JobContext& ctx) {
     double capture_ms = 0.0;
     PosePreparer preparer(config_.measure);
     Result<Session> session = Capture(ctx, capture_ms, &preparer);
+    const int prepared_during_capture = preparer.Prepared();
     if (!session) {
         JobOutput out = FailedOutput(session.error().code, session.error().message);
         out.result.timing_ms["capture"] = capture_ms;
@@ -190,8 +191,8 @@ JobOutput DeviceStation::Measure(const JobContext& ctx) {
     if (ctx.progress) ctx.progress(JobProgress{"processing", poses, poses});
     const auto t_processing = std::chrono::steady_clock::now();
     std::vector<PreparedPose> prepared = preparer.Finish(*session);
-    spdlog::debug("measurement {}: {} of {} poses prepared during the capture", ctx.id,
-                  preparer.prepared_early(), poses);
+    spdlog::info("measurement {}: {} of {} poses prepared during the capture", ctx.id,
+                 prepared_during_capture, poses);
     Result<MeasureOutput> measured =
         MeasurePrepared(*session, std::move(prepared), config_.measure, config_.method);
     if (!measured) {

@@ -38,6 +38,11 @@ void PosePreparer::Work() {
     }
 }
 
+int PosePreparer::Prepared() const {
+    std::lock_guard lock(mutex_);
+    return static_cast<int>(done_.size());
+}
+
 std::vector<PreparedPose> PosePreparer::Finish(const Session& session) {
     // The worker finishes the pose in hand; what is still queued is prepared below on all
     // threads (a source faster than the first stage, like a replay, leaves a backlog).
@@ -45,7 +50,6 @@ std::vector<PreparedPose> PosePreparer::Finish(const Session& session) {
     {
         std::lock_guard lock(mutex_);
         stop_ = true;
-        prepared_early_ = static_cast<int>(done_.size());
     }
     wake_.notify_all();
     if (worker_.joinable()) worker_.join();

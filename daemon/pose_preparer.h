@@ -29,8 +29,8 @@ public:
     // queued and what was never queued (from the session's frames), on config.threads threads.
     std::vector<PreparedPose> Finish(const Session& session);
 
-    // How many poses the worker had prepared when Finish was called (for the log).
-    int prepared_early() const { return prepared_early_; }
+    // Returns how many poses the worker has prepared so far.
+    int Prepared() const;
 
 private:
     void Work();
@@ -41,12 +41,11 @@ private:
         double depth_unit_m;
     };
     const MeasureConfig config_;
-    std::mutex mutex_;
+    mutable std::mutex mutex_;
     std::condition_variable wake_;
     std::deque<Job> queue_;
     std::vector<std::pair<std::size_t, PreparedPose>> done_;
     bool stop_ = false;
-    int prepared_early_ = 0;
     std::thread worker_;
 };
 
