@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <ostream>
 
 #include "pipeline/synthetic_station.h"
 
@@ -20,6 +21,12 @@ struct Injected {
     double axis_error_deg;
     double depth_offset_m;
 };
+
+// How ctest lists a case (instead of its bytes).
+void PrintTo(const Injected& inj, std::ostream* os) {
+    *os << "seed " << inj.seed << ", centre off " << inj.center_error_m * 1000.0 << " mm, axis off "
+        << inj.axis_error_deg << " deg, depth offset " << inj.depth_offset_m * 1000.0 << " mm";
+}
 
 SyntheticStationConfig ReferenceStation(const Injected& inj) {
     SyntheticStationConfig c;
