@@ -55,30 +55,10 @@ struct InitialEstimate {
 Result<InitialEstimate> EstimateInitial(const Session& session, const MeasureConfig& mc) {
     InitialEstimate est;
     const int n = static_cast<int>(session.poses.size());
-    est.depths.resize(static_cast<std::size_t>(n));
-    std::vector<std::string> errors(static_cast<std::size_t>(n));
-    ParallelFor(n, mc.threads, [&](int k) {
-        const auto i = static_cast<std::size_t>(k);
-        auto avg =
-            AverageDepthFrames(session.poses[i].frames, session.camera.depth_unit_m, mc.averaging);
-        if (!avg) {
-            errors[i] = avg.error().message;
-            return;
-        }
-        est.depths[i] = RemoveFlyingPixels(*avg, mc.flying_pixels);
-    });
-    for (int k = 0; k < n; ++k) {
-        const auto i = static_cast<std::size_t>(k);
-        if (!errors[i].empty()) {
-            return Error{code::kTableNotVisible, "pose " + std::to_string(k) + ": " + errors[i]};
-        }
-        const double valid = ValidFraction(est.depths[i]);
-        if (valid < mc.refusal.min_pose_valid_fraction) {
-            return Error{code::kTableNotVisible, "pose " + std::to_string(k) +
-                                                     " has depth readings in only " +
-                                                     Fmt("%.1f%% of its pixels", 100.0 * valid)};
-        }
-    }
+    // The measurement pipeline's first stage and its test of usable poses.
+    auto depths = UsableDepths(PrepareSession(session, mc), mc.refusal);
+    if (!depths) return Error{code::kTableNotVisible, depths.error().message};
+    est.depths = std::move(*depths);
     auto table = FitTablePlane(est.depths, session.camera, session.calibration, mc.table_plane);
     if (!table) {
         return Error{

@@ -131,17 +131,39 @@ PreparedPose PreparePose(const std::vector<DepthImage>& frames, double depth_uni
     return out;
 }
 
+std::vector<PreparedPose> PrepareSession(const Session& session, const MeasureConfig& config) {
+    std::vector<PreparedPose> prepared(session.poses.size());
+    ParallelFor(static_cast<int>(prepared.size()), config.threads, [&](int k) {
+        const auto i = static_cast<std::size_t>(k);
+        prepared[i] = PreparePose(session.poses[i].frames, session.camera.depth_unit_m, config);
+    });
+    return prepared;
+}
+
+Result<std::vector<DepthMap>> UsableDepths(std::vector<PreparedPose> poses,
+                                           const RefusalConfig& refuse) {
+    std::vector<DepthMap> depths(poses.size());
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+        const std::string pose = "pose " + std::to_string(i);
+        if (!poses[i].error.empty()) {
+            return Error{reason::kInsufficientData, pose + ": " + poses[i].error};
+        }
+        depths[i] = std::move(poses[i].depth);
+        const double valid = ValidFraction(depths[i]);
+        if (valid < refuse.min_pose_valid_fraction) {
+            return Error{reason::kInsufficientData, pose + " has valid depth readings in only " +
+                                                        Fmt("%.1f%% of its pixels", 100.0 * valid)};
+        }
+    }
+    return depths;
+}
+
 Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig& config,
                                      BoxMethod method) {
     if (Status s = config.Validate(); !s) return s.error();
     const auto start = Clock::now();
     const std::string started_at = UtcTimestampNow();
-    const int n = static_cast<int>(session.poses.size());
-    std::vector<PreparedPose> prepared(static_cast<std::size_t>(n));
-    ParallelFor(n, config.threads, [&](int k) {
-        const auto i = static_cast<std::size_t>(k);
-        prepared[i] = PreparePose(session.poses[i].frames, session.camera.depth_unit_m, config);
-    });
+    std::vector<PreparedPose> prepared = PrepareSession(session, config);
     const double first_stage_ms = Ms(start, Clock::now());
     auto out = MeasurePrepared(session, std::move(prepared), config, method);
     if (out) {
@@ -172,22 +194,9 @@ Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<Prepar
     const RefusalConfig& refuse = config.refusal;
     if (n == 0) return run.Refuse(reason::kInsufficientData, "the session has no poses");
 
-    std::vector<DepthMap> depths(static_cast<std::size_t>(n));
-    for (int k = 0; k < n; ++k) {
-        const auto i = static_cast<std::size_t>(k);
-        if (!poses[i].error.empty()) {
-            return run.Refuse(reason::kInsufficientData,
-                              "pose " + std::to_string(k) + ": " + poses[i].error);
-        }
-        depths[i] = std::move(poses[i].depth);
-        const double valid = ValidFraction(depths[i]);
-        if (valid < refuse.min_pose_valid_fraction) {
-            return run.Refuse(reason::kInsufficientData,
-                              "pose " + std::to_string(k) + " has valid depth readings in only " +
-                                  Fmt("%.1f%% of its pixels", 100.0 * valid));
-        }
-    }
-    poses.clear();
+    auto usable = UsableDepths(std::move(poses), refuse);
+    if (!usable) return run.Refuse(reason::kInsufficientData, usable.error().message);
+    std::vector<DepthMap> depths = std::move(*usable);
 
     // Stage 2: the refitted table frame, then each view's object points.
     auto table = FitTablePlane(depths, session.camera, session.calibration, config.table_plane);

@@ -84,6 +84,14 @@ struct PreparedPose {
 PreparedPose PreparePose(const std::vector<DepthImage>& frames, double depth_unit_m,
                          const MeasureConfig& config);
 
+// Returns every pose of `session` through PreparePose, on config.threads threads.
+std::vector<PreparedPose> PrepareSession(const Session& session, const MeasureConfig& config);
+
+// Returns the prepared poses' depth maps in pose order, or why one cannot be used (a message
+// naming the pose: its frames could not be averaged, or too few of its pixels have a reading).
+Result<std::vector<DepthMap>> UsableDepths(std::vector<PreparedPose> poses,
+                                           const RefusalConfig& refuse);
+
 // Returns the measurement of `session` whose poses went through PreparePose already, in pose
 // order (`session.poses` supply the angles; their frames are not read again). The same numbers
 // as MeasureSession on the same session.
