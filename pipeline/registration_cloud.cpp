@@ -131,10 +131,6 @@ OrientedPoints Orient(const Points& voxels, const RegistrationCloudConfig& confi
 
 }  // namespace
 
-Points VoxelDownsample(const Points& points, double voxel_m) {
-    return VoxelGrid(points, nullptr, voxel_m).centroids;
-}
-
 OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config) {
     return Orient(ReduceVoxels(VoxelGrid(points, nullptr, config.voxel_m), config.voxel_m, config),
                   config);

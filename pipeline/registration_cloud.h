@@ -42,7 +42,4 @@ RegistrationClouds BuildRegistrationClouds(const Points& points,
                                            const RegistrationCloudConfig& coarse,
                                            const RegistrationCloudConfig& fine);
 
-// Returns the centroids of the occupied voxels of size `voxel_m`, in first-met order.
-Points VoxelDownsample(const Points& points, double voxel_m);
-
 }  // namespace boxd
