@@ -28,7 +28,6 @@ using namespace std::chrono_literals;
 
 const fs::path kSimConfig = test::SimConfigPath();
 
-using test::ChildProcess;
 using test::NotifySocket;
 using test::ReadText;
 using Daemon = test::ServeDaemon;
@@ -199,15 +198,8 @@ TEST(ServeSimStation, MeasuresTheSimulatedBoxAndServesItAcrossKill9) {
 // from the drive's own status register, over Modbus, after the daemon is gone.
 TEST(ServeSimStation, SigtermDuringAMeasurementStopsTheTableAndExitsCleanly) {
     test::TempDir dir;
-    const fs::path port_file = dir / "sim.port";
-    ChildProcess sim({BOXD_BINARY, "sim-turntable", "--port", "0", "--port-file",
-                      port_file.string(), "--speed-dps", "15"},
-                     dir / "sim.log");
-    int sim_port = 0;
-    for (int i = 0; i < 500 && sim_port == 0; ++i) {
-        std::ifstream(port_file) >> sim_port;
-        std::this_thread::sleep_for(10ms);
-    }
+    test::SimTurntableProcess sim({"--speed-dps", "15"}, dir / "sim.log");
+    const int sim_port = sim.port();
     ASSERT_GT(sim_port, 0) << ReadText(dir / "sim.log");
 
     // The simulated station, but with the turntable this test started: a slow one, so that the
@@ -262,7 +254,7 @@ TEST(ServeSimStation, SigtermDuringAMeasurementStopsTheTableAndExitsCleanly) {
     const json aborted = again.GetJson("/v1/measurements/m-000001");
     EXPECT_EQ(aborted["status"], "failed") << aborted.dump();
     EXPECT_EQ(aborted["reason"]["code"], "ABORTED") << aborted.dump();
-    sim.Signal(SIGTERM);
+    sim.process().Signal(SIGTERM);
 }
 
 // Under systemd: READY=1 once serving, WATCHDOG=1 from the loop's timer, STOPPING=1 on SIGTERM.

@@ -115,11 +115,12 @@ int ChildProcess::Terminate(std::chrono::milliseconds grace) {
     return exit_code_;
 }
 
-SimTurntableProcess::SimTurntableProcess(const std::vector<std::string>& extra_args) {
+SimTurntableProcess::SimTurntableProcess(const std::vector<std::string>& extra_args,
+                                         const std::filesystem::path& log) {
     std::vector<std::string> argv{BOXD_BINARY, "sim-turntable", "--port",
                                   "0",         "--port-file",   (dir_ / "port").string()};
     argv.insert(argv.end(), extra_args.begin(), extra_args.end());
-    process_ = std::make_unique<ChildProcess>(argv);
+    process_ = std::make_unique<ChildProcess>(argv, log);
     const auto deadline = Clock::now() + std::chrono::seconds(10);
     while (Clock::now() < deadline && process_->Running()) {
         std::ifstream in(dir_ / "port");

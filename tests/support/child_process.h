@@ -51,10 +51,12 @@ private:
 };
 
 // `boxd sim-turntable` on a free loopback port (the simulator picks it and writes it to a file,
-// so there is no race for the port), with `extra_args` appended.
+// so there is no race for the port), with `extra_args` appended; its stderr is appended to `log`
+// when one is given.
 class SimTurntableProcess {
 public:
-    explicit SimTurntableProcess(const std::vector<std::string>& extra_args);
+    explicit SimTurntableProcess(const std::vector<std::string>& extra_args,
+                                 const std::filesystem::path& log = {});
 
     // Returns the TCP port, or 0 if the simulator did not start.
     int port() const { return port_; }
