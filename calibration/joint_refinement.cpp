@@ -68,6 +68,14 @@ T FaceDistance(int group, const T& u, const T& v, const T& z, const BoxDimension
     }
 }
 
+// Table residual. A pixel with back-projection ray a (camera frame, turned into the base
+// table frame: base · p = a z + t0) and raw depth z_raw lies, with the state's depth correction
+// z = z_raw · scale + offset, at
+//     q = R(tilt)ᵀ (a z + t0 − centre)
+// in the corrected table frame (TablePoint). A point of the table top satisfies q_z = 0, so
+//     r = w · q_z,
+// with w = 1 / (the table group's robust sigma): table and face residuals are weighed by their
+// own noise, not by how many points each group has.
 struct TableCost {
     const PosePoints* pts;
     std::vector<int> idx;
@@ -86,6 +94,16 @@ struct TableCost {
     }
 };
 
+// Face residual. A pixel of pose k assigned to face f of the reference box lies at q (as for
+// the table). Turned back by the table's angle α_k about the axis, it sat at R(−α_k) q at pose 0;
+// in box coordinates (u along the length, v along the width, the box centred at (b_x, b_y) and
+// turned by β),
+//     (u, v) = R(−β) ( R(−α_k) q_xy − b )      (BoxPoint).
+// A point on face f of a box of the REFERENCE size L × W × H satisfies the face's plane
+// equation, and the residual is its signed distance outside that face (FaceDistance):
+//     r = w · (±u − L/2),  w · (±v − W/2)  or  w · (q_z − H)   (side faces, top).
+// Because L, W, H are fixed, the depth offset and scale that stretch the cloud are observable:
+// no other state makes all faces meet the known box.
 struct FaceCost {
     const PosePoints* pts;
     std::vector<int> idx;
@@ -193,7 +211,7 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
                                     const JointState& init, const JointRefinementConfig& config) {
     const std::size_t n = views.size();
     if (init.angle_rad.size() != n) {
-        return Error{"INVALID_CONFIG", "joint refinement: one angle per view is needed"};
+        return Error{ErrorCode::kInvalidConfig, "joint refinement: one angle per view is needed"};
     }
     (void)camera;
     const Eigen::Matrix3d r0 = init.base.linear();
@@ -264,7 +282,7 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
             }
         }
         if (sol.table_points < 500 || sol.face_points < 500) {
-            return Error{"NOT_CONVERGED",
+            return Error{ErrorCode::kNotConverged,
                          "too few points on the table (" + std::to_string(sol.table_points) +
                              ") or on the reference box faces (" + std::to_string(sol.face_points) +
                              ") agree with the model"};
@@ -283,7 +301,7 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
             outer, sol.table_points, sol.face_points, summary.initial_cost, summary.final_cost,
             s.depth[0]);
         if (!summary.IsSolutionUsable()) {
-            return Error{"NOT_CONVERGED",
+            return Error{ErrorCode::kNotConverged,
                          "the joint calibration problem did not converge: " + summary.message};
         }
     }

@@ -1,26 +1,24 @@
 #include "calibration/station_calibrator.h"
 
+#include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "calibration/joint_refinement.h"
 #include "calibration/turntable_centre.h"
-#include "pipeline/parallel_for.h"
+#include "pipeline/fuse_and_fit.h"
+#include "pipeline/object_views.h"
+#include "pipeline/prepare_pose.h"
+#include "pipeline/refusal.h"
+#include "pipeline/register_views.h"
+#include "pipeline/table_plane.h"
 
 namespace boxd {
 
 namespace {
 
-namespace code = calibration_error;
-
-std::string Fmt(const char* fmt, double a, double b = 0.0, double c = 0.0) {
-    char buf[256];
-    std::snprintf(buf, sizeof(buf), fmt, a, b, c);
-    return buf;
-}
 
 BoxDimensions Sorted(const BoxDimensions& d) {
     return {std::max(d.length_m, d.width_m), std::min(d.length_m, d.width_m), d.height_m};
@@ -49,98 +47,66 @@ struct InitialEstimate {
     BoxFit box;                         // free fit of the reference box, same frame
 };
 
-// Runs the measurement pipeline's stages with the recorded calibration: averaged depth maps,
-// table plane, segmentation, pairwise ICP, pose graph, fusion and the footprint box fit; then
-// moves the table frame's origin to the turntable centre the registered views rotate about.
+// Returns why a reference session cannot calibrate, from the measurement's refusal `why`: a box
+// that is not seen whole or not at all is NO_REFERENCE, views that disagree are BOX_MOVED.
+Error AsCalibrationRefusal(const MeasurementReason& why) {
+    switch (why.code) {
+        case ErrorCode::kObjectMoved:
+        case ErrorCode::kRegistrationFailed:
+            return Error{ErrorCode::kBoxMoved, "reference box: " + why.message};
+        default:
+            return Error{ErrorCode::kNoReference, "reference box: " + why.message};
+    }
+}
+
+// The measurement recipe's stages 1 to 6 with the recorded calibration (the same calls, the
+// same refusal rules), then the origin moved to the turntable centre the registered views
+// rotate about.
 Result<InitialEstimate> EstimateInitial(const Session& session, const MeasureConfig& mc) {
     InitialEstimate est;
-    const int n = static_cast<int>(session.poses.size());
-    // The measurement pipeline's first stage and its test of usable poses.
     auto depths = UsableDepths(PrepareSession(session, mc), mc.refusal);
-    if (!depths) return Error{code::kTableNotVisible, depths.error().message};
+    if (!depths) return Error{ErrorCode::kTableNotVisible, depths.error().message};
     est.depths = std::move(*depths);
     auto table = FitTablePlane(est.depths, session.camera, session.calibration, mc.table_plane);
     if (!table) {
         return Error{
-            code::kTableNotVisible,
+            ErrorCode::kTableNotVisible,
             "the table top around the reference box is not visible: " + table.error().message};
     }
+    ObjectViews views = SegmentObjectViews(
+        est.depths, session.camera, session.calibration, table->camera_to_table, mc.segmentation,
+        mc.registration.coarse_cloud, mc.registration.fine_cloud, mc.threads);
+    if (auto why = CheckObjectViews(views, mc.refusal)) return AsCalibrationRefusal(*why);
 
-    std::vector<SegmentedView> views(static_cast<std::size_t>(n));
-    std::vector<ViewClouds> clouds(static_cast<std::size_t>(n));
-    ParallelFor(n, mc.threads, [&](int k) {
-        const auto i = static_cast<std::size_t>(k);
-        views[i] = SegmentView(est.depths[i], session.camera, session.calibration,
-                               table->camera_to_table, mc.segmentation);
-        clouds[i] = BuildRegistrationClouds(views[i].points, mc.registration.coarse_cloud,
-                                            mc.registration.fine_cloud);
-    });
-    long object_points = 0;
-    for (int k = 0; k < n; ++k) {
-        const SegmentedView& v = views[static_cast<std::size_t>(k)];
-        object_points += static_cast<long>(v.points.size());
-        if (v.border_points > mc.refusal.max_border_points) {
-            return Error{
-                code::kNoReference,
-                "the reference box is cut by the image border in pose " + std::to_string(k)};
-        }
-    }
-    if (object_points < mc.refusal.min_object_points) {
-        return Error{code::kNoReference, "no reference box stands on the table"};
-    }
-
-    std::vector<double> angles(static_cast<std::size_t>(n));
-    for (int k = 0; k < n; ++k) {
-        angles[static_cast<std::size_t>(k)] = session.PoseAngleRad(static_cast<std::size_t>(k));
-    }
-    PoseGraph graph;
-    graph.poses = TurntablePoses(angles);
-    for (const Se2& p : graph.poses) graph.commanded_yaw.push_back(p.yaw);
-    EdgeStats edge_stats;
-    graph.edges = RegisterViewPairs(clouds, angles, mc.registration, &edge_stats);
-    auto report = OptimizePoseGraph(graph, mc.pose_graph);
-    if (!report) {
-        return Error{code::kBoxMoved,
-                     "the views of the reference box do not register: " + report.error().message};
-    }
-    // The measurement pipeline's tests of registered views: a box that moved (or views that do
-    // not register) cannot calibrate anything.
-    if (auto why = CheckRegisteredViews(*report, n, mc.refusal)) {
-        return Error{code::kBoxMoved, "reference box: " + why->message};
+    const int n = static_cast<int>(session.poses.size());
+    auto registered = RegisterViews(views.clouds, session.PoseAnglesRad(), mc.registration,
+                                    mc.pose_graph, nullptr);
+    if (!registered) return AsCalibrationRefusal(registered.error());
+    if (auto why = CheckRegisteredViews(*registered, n, mc.refusal)) {
+        return AsCalibrationRefusal(*why);
     }
 
     // The centre the registered views rotate about ((I - R_k) c = t_k, least squares).
-    auto centre = FitTurntableCentre(graph.poses);
-    if (!centre) return Error{code::kTooFewPoses, centre.error().message};
+    auto centre = FitTurntableCentre(registered->poses);
+    if (!centre) return Error{ErrorCode::kTooFewPoses, centre.error().message};
     spdlog::debug("calibrate: registered views turn about ({:.4f}, {:.4f}) m, rms {:.4f} m",
                   centre->center.x(), centre->center.y(), centre->rms_m);
 
-    std::vector<Points> view_points(static_cast<std::size_t>(n));
-    for (int k = 0; k < n; ++k) {
-        view_points[static_cast<std::size_t>(k)] =
-            std::move(views[static_cast<std::size_t>(k)].points);
+    std::vector<Points> view_points(views.views.size());
+    for (std::size_t k = 0; k < view_points.size(); ++k) {
+        view_points[k] = std::move(views.views[k].fusion_points);
     }
-    FusedCloud fused = FuseViews(view_points, graph.poses, mc.fusion);
-    auto fit = FitFootprintBox(fused.points, mc.box_fit);
-    if (!fit) {
-        return Error{code::kNoReference,
-                     "the reference box could not be measured: " + fit.error().message};
-    }
-    const ConsistencyReport consistency = CheckViewConsistency(fused, n, *fit, mc.fusion);
-    if (!consistency.inconsistent_views.empty()) {
-        return Error{code::kBoxMoved,
-                     "view " + std::to_string(consistency.worst_view) +
-                         " disagrees with the others: the reference box moved on the table"};
-    }
+    const FusedFit fit = FuseAndFit(view_points, registered->poses, mc.fusion, mc.box_fit, nullptr);
+    if (auto why = CheckFusedFit(fit, mc.refusal)) return AsCalibrationRefusal(*why);
 
     // Move the origin to the centre: registered motions become rotations about the origin.
     Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
     shift.translation() = Eigen::Vector3d(-centre->center.x(), -centre->center.y(), 0.0);
     est.camera_to_table = shift * table->camera_to_table;
-    for (const Se2& p : graph.poses) {
+    for (const Se2& p : registered->poses) {
         est.poses.push_back(Se2::RotationAbout(p.yaw, Eigen::Vector2d::Zero()));
     }
-    est.box = *fit;
+    est.box = *fit.box;
     est.box.center_m -= centre->center;
     return est;
 }
@@ -182,7 +148,7 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
 
 Status CalibrationConfig::Validate() const {
     auto bad = [](const std::string& f, const std::string& why) -> Status {
-        return Error{code::kInvalidConfig, "calibration." + f + ": " + why};
+        return Error{ErrorCode::kInvalidConfig, "calibration." + f + ": " + why};
     };
     if (Status s = measure.Validate(); !s) return s;
     if (min_poses < 3) return bad("min_poses", "must be >= 3");
@@ -213,12 +179,12 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
     if (Status s = config.Validate(); !s) return s.error();
     const BoxDimensions ref = Sorted(reference);
     if (!(ref.width_m > 0.0 && ref.height_m > 0.0) || ref.length_m > 2.0 || ref.height_m > 2.0) {
-        return Error{code::kWrongReference,
+        return Error{ErrorCode::kWrongReference,
                      "the reference size must be positive and at most 2 m per side"};
     }
     const int n = static_cast<int>(session.poses.size());
     if (n < config.min_poses) {
-        return Error{code::kTooFewPoses,
+        return Error{ErrorCode::kTooFewPoses,
                      "calibration needs at least " + std::to_string(config.min_poses) +
                          " poses around the turntable, the session has " + std::to_string(n)};
     }
@@ -238,13 +204,12 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
         est->box.length_m, est->box.width_m, est->box.height_m, ref.length_m, ref.width_m,
         ref.height_m);
     if (mismatch > config.max_reference_mismatch) {
-        return Error{code::kWrongReference,
-                     "the box on the table measures " +
-                         Fmt("%.3f x %.3f x %.3f m", est->box.length_m, est->box.width_m,
-                             est->box.height_m) +
-                         ", not the stated reference " +
-                         Fmt("%.3f x %.3f x %.3f m", ref.length_m, ref.width_m, ref.height_m) +
-                         Fmt(" (%.0f%% off): wrong reference box?", 100.0 * mismatch)};
+        return Error{ErrorCode::kWrongReference,
+                     fmt::format("the box on the table measures {:.3f} x {:.3f} x {:.3f} m, not "
+                                 "the stated reference {:.3f} x {:.3f} x {:.3f} m ({:.0f}% off): "
+                                 "wrong reference box?",
+                                 est->box.length_m, est->box.width_m, est->box.height_m,
+                                 ref.length_m, ref.width_m, ref.height_m, 100.0 * mismatch)};
     }
 
     JointState init;
@@ -273,11 +238,13 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
     const double face_rms_limit =
         std::max(config.face_rms_ratio * sol->table_rms_m, config.face_rms_floor_m);
     if (sol->face_rms_m > face_rms_limit) {
-        return Error{code::kNotConverged,
-                     Fmt("no station geometry makes the views show a box of the stated size: its "
-                         "faces fit to %.1f mm RMS (limit %.1f mm, table %.1f mm); check the "
-                         "reference size, and that the box is rigid and did not move",
-                         sol->face_rms_m * 1e3, face_rms_limit * 1e3, sol->table_rms_m * 1e3)};
+        return Error{ErrorCode::kNotConverged,
+                     fmt::format("no station geometry makes the views show a box of the stated "
+                                 "size: its faces fit to {:.1f} mm RMS (limit {:.1f} mm, table "
+                                 "{:.1f} mm); check the reference size, and that the box is rigid "
+                                 "and did not move",
+                                 sol->face_rms_m * 1e3, face_rms_limit * 1e3,
+                                 sol->table_rms_m * 1e3)};
     }
 
     report.calibration = sol->calibration;
@@ -299,7 +266,7 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
         (report.calibration.table_center_m - report.recorded.table_center_m).norm();
     report.axis_change_deg = AngleDeg(report.calibration.table_axis, report.recorded.table_axis);
     if (Status s = report.calibration.Validate(); !s) {
-        return Error{code::kNotConverged,
+        return Error{ErrorCode::kNotConverged,
                      "the estimate is not a valid calibration: " + s.error().message};
     }
     return report;

@@ -7,24 +7,12 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/measure_pipeline.h"
+#include "pipeline/measure_config.h"
 #include "pipeline/result.h"
 #include "pipeline/session.h"
 #include "pipeline/station_calibration.h"
 
 namespace boxd {
-
-// Error codes of CalibrateStation (Error::code); `boxd calibrate` exits 2 on every one of them
-// except an invalid configuration (exit 1).
-namespace calibration_error {
-inline constexpr const char* kTooFewPoses = "TOO_FEW_POSES";
-inline constexpr const char* kTableNotVisible = "TABLE_NOT_VISIBLE";
-inline constexpr const char* kNoReference = "NO_REFERENCE";  // no box / no size could be measured
-inline constexpr const char* kWrongReference = "WRONG_REFERENCE";  // > 10% off its stated size
-inline constexpr const char* kBoxMoved = "BOX_MOVED";
-inline constexpr const char* kNotConverged = "NOT_CONVERGED";
-inline constexpr const char* kInvalidConfig = "INVALID_CONFIG";
-}  // namespace calibration_error
 
 // Returns the measurement pipeline's defaults with the table-plane search widened: a station
 // being calibrated may be off by centimetres and degrees.

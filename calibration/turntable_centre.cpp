@@ -21,7 +21,7 @@ Result<TurntableCentreFit> FitTurntableCentre(const std::vector<Se2>& poses) {
         ++fit.poses;
     }
     if (fit.poses == 0) {
-        return Error{"INSUFFICIENT_DATA", "no view turns the table by more than a degree"};
+        return Error{ErrorCode::kInsufficientData, "no view turns the table by more than a degree"};
     }
     fit.center = ata.ldlt().solve(atb);
     double sum = 0.0;

@@ -51,7 +51,7 @@ int RunBench(const BenchOptions& opt) {
     const double cpu0 = CpuSeconds();
     for (int i = 0; i < opt.runs; ++i) {
         const auto a = Clock::now();
-        auto out = MeasureSession(*session, config, BoxMethod::kFootprint);
+        auto out = MeasureSession(*session, config, BoxMethod::kFootprint, SteadyClockMs());
         wall.push_back(std::chrono::duration<double, std::milli>(Clock::now() - a).count());
         if (!out) {
             std::fprintf(stderr, "boxd: bench-measure: %s\n", out.error().message.c_str());

@@ -31,13 +31,13 @@ int RunCalibrate(const CalibrateOptions& opt) {
     config.estimate_depth_scale = opt.estimate_depth_scale;
     auto report = CalibrateStation(*session, reference, config);
     if (!report) {
-        if (report.error().code == calibration_error::kInvalidConfig) {
+        if (report.error().code == ErrorCode::kInvalidConfig) {
             spdlog::critical("calibrate: {}", report.error().message);
             return kExitInternal;
         }
         // Every refusal (too few poses, table not visible, wrong reference, box moved, no
         // convergence) is a problem with the input session: exit 2 with the code in the line.
-        return FailBadInput("calibrate: " + report.error().code + ": " + report.error().message);
+        return FailBadInput("calibrate: " + std::string(ErrorCodeName(report.error().code)) + ": " + report.error().message);
     }
     if (!opt.out.empty()) {
         std::ofstream file(opt.out);

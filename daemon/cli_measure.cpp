@@ -24,11 +24,21 @@ int RunMeasure(const MeasureOptions& opt) {
     auto session = LoadSession(opt.session);
     if (!session) return FailBadInput(session.error().message);
     const BoxMethod method = opt.method == "pca" ? BoxMethod::kPca : BoxMethod::kFootprint;
-    auto out = MeasureSession(*session, MeasureConfig{}, method);
+    // The command line is an edge of the pipeline: it owns the id, the timestamps and the clock.
+    const MonotonicMs clock = SteadyClockMs();
+    const std::string started_at = UtcTimestampNow();
+    const double start_ms = clock();
+    auto out = MeasureSession(*session, MeasureConfig{}, method, clock);
     if (!out) {
         spdlog::critical("measure: {}", out.error().message);
         return kExitInternal;
     }
+    MeasurementResult& result = out->result;
+    result.id = "offline";
+    result.started_at = started_at;
+    result.finished_at = UtcTimestampNow();
+    result.timing_ms["capture"] = 0.0;
+    result.timing_ms["processing"] = clock() - start_ms;
     if (!opt.cloud.empty()) {
         if (Status s = WritePly(opt.cloud, out->cloud); !s) return FailBadInput(s.error().message);
     }

@@ -33,7 +33,7 @@ std::atomic<bool> g_cancel{false};
 void OnRecordStopSignal(int) { g_cancel.store(true); }
 
 bool IsInputError(const Error& e) {
-    return e.code == "INVALID_INPUT" || e.code == "INVALID_SESSION";
+    return CategoryOf(e.code) == ErrorCategory::kBadInput;
 }
 
 int RunRecord(const RecordOptions& options) {
@@ -49,7 +49,7 @@ int RunRecord(const RecordOptions& options) {
     auto devices = OpenStation(*config);
     if (!devices) {
         if (IsInputError(devices.error())) return FailBadInput(devices.error().message);
-        std::fprintf(stderr, "boxd: error: %s: %s\n", devices.error().code.c_str(),
+        std::fprintf(stderr, "boxd: error: %s: %s\n", ErrorCodeName(devices.error().code),
                      devices.error().message.c_str());
         return kExitInternal;
     }
@@ -73,7 +73,7 @@ int RunRecord(const RecordOptions& options) {
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);
     if (!session) {
-        std::fprintf(stderr, "boxd: error: %s: %s\n", session.error().code.c_str(),
+        std::fprintf(stderr, "boxd: error: %s: %s\n", ErrorCodeName(session.error().code),
                      session.error().message.c_str());
         return kExitInternal;
     }

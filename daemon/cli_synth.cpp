@@ -14,7 +14,7 @@
 
 #include "daemon/cli.h"
 #include "pipeline/session_io.h"
-#include "pipeline/synthetic_station.h"
+#include "drivers/sim/synthetic_station.h"
 
 namespace boxd::cli {
 
@@ -46,7 +46,7 @@ Result<std::vector<fs::path>> PreviousSyntheticFrames(const fs::path& dir, bool 
     std::error_code ec;
     if (!fs::exists(dir, ec)) return std::vector<fs::path>{};
     if (!fs::is_directory(dir, ec)) {
-        return Error{"INVALID_INPUT", "--out " + dir.string() + ": exists and is not a folder"};
+        return Error{ErrorCode::kInvalidInput, "--out " + dir.string() + ": exists and is not a folder"};
     }
     if (fs::directory_iterator(dir, ec) == fs::directory_iterator()) {
         return std::vector<fs::path>{};
@@ -60,7 +60,7 @@ Result<std::vector<fs::path>> PreviousSyntheticFrames(const fs::path& dir, bool 
                            previous.value("format", "") == kSessionFormat;
     if (!synthetic) {
         if (force) return std::vector<fs::path>{};  // write over it, delete nothing
-        return Error{"INVALID_INPUT", "--out " + dir.string() +
+        return Error{ErrorCode::kInvalidInput, "--out " + dir.string() +
                                           ": folder is not empty and holds no synthetic session "
                                           "(use --force to write into it anyway)"};
     }
@@ -129,7 +129,7 @@ Result<SyntheticStationConfig> MakeConfig(const SynthOptions& o) {
             c.moved_dyaw_deg = o.move_by.at(2);
         }
     } else if (!o.move_by.empty()) {
-        return Error{"INVALID_INPUT", "--move-by needs --move-at-pose"};
+        return Error{ErrorCode::kInvalidInput, "--move-by needs --move-at-pose"};
     }
     if (auto st = c.Validate(); !st) return st.error();
     return c;

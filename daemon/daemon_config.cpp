@@ -11,7 +11,7 @@ namespace boxd {
 namespace {
 
 Error ConfigError(const std::string& key, const std::string& what) {
-    return Error{"INVALID_INPUT", key + ": " + what};
+    return Error{ErrorCode::kInvalidInput, key + ": " + what};
 }
 
 // Rejects keys of `node` that are not in `known`: a typo must not silently keep a default.

@@ -1,5 +1,7 @@
 #include "daemon/device_station.h"
 
+#include "pipeline/measure_pipeline.h"
+
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -19,7 +21,7 @@ double MsSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-JobOutput FailedOutput(const std::string& code, const std::string& message) {
+JobOutput FailedOutput(ErrorCode code, const std::string& message) {
     JobOutput out;
     out.result.status = MeasurementStatus::kFailed;
     out.result.reason = MeasurementReason{code, message};
@@ -102,7 +104,7 @@ Status DeviceStation::Open() {
 }
 
 void DeviceStation::MarkDeviceError(const Error& error) {
-    spdlog::error("device error: {}: {}", error.code, error.message);
+    spdlog::error("device error: {}: {}", ErrorCodeName(error.code), error.message);
     std::lock_guard lock(devices_mutex_);
     device_error_ = error;
     open_ = false;
@@ -133,7 +135,7 @@ Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms
         std::lock_guard lock(devices_mutex_);
         devices = devices_.get();
     }
-    if (!devices || !open_) return Error{kCameraErrorCode, "the devices are not open"};
+    if (!devices || !open_) return Error{ErrorCode::kCameraError, "the devices are not open"};
     devices->turntable->ClearStopRequest();
     const int poses = static_cast<int>(devices->capture.Angles().size());
     if (ctx.progress) ctx.progress(JobProgress{"capture", 0, poses});
@@ -154,7 +156,7 @@ Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms
     capture_ms = MsSince(t_capture);
     if (!session) {
         const Error& e = session.error();
-        if (e.code == kTurntableErrorCode || e.code == kCameraErrorCode) MarkDeviceError(e);
+        if (e.code == ErrorCode::kTurntableError || e.code == ErrorCode::kCameraError) MarkDeviceError(e);
     }
     return session;
 }
@@ -181,7 +183,7 @@ JobOutput DeviceStation::Measure(const JobContext& ctx) {
         }
     }
     if (ctx.cancelled()) {
-        JobOutput aborted = FailedOutput("ABORTED", "cancelled after the capture");
+        JobOutput aborted = FailedOutput(ErrorCode::kAborted, "cancelled after the capture");
         aborted.result.timing_ms["capture"] = capture_ms;
         aborted.files = out.files;
         return aborted;
@@ -193,8 +195,9 @@ JobOutput DeviceStation::Measure(const JobContext& ctx) {
     std::vector<PreparedPose> prepared = preparer.Finish(*session);
     spdlog::info("measurement {}: {} of {} poses prepared during the capture", ctx.id,
                  prepared_during_capture, poses);
-    Result<MeasureOutput> measured =
-        MeasurePrepared(*session, std::move(prepared), config_.measure, config_.method);
+    Result<MeasureOutput> measured = MeasurePrepared(*session, std::move(prepared),
+                                                     config_.measure, config_.method,
+                                                     SteadyClockMs());
     if (!measured) {
         JobOutput failed = FailedOutput(measured.error().code, measured.error().message);
         failed.result.timing_ms["capture"] = capture_ms;
@@ -232,11 +235,11 @@ Result<json> DeviceStation::Calibrate(const JobContext& ctx, const BoxDimensions
     {
         std::ofstream file(tmp);
         file << out.dump(2) << "\n";
-        if (!file) return Error{"STORAGE_ERROR", "cannot write " + tmp};
+        if (!file) return Error{ErrorCode::kStorageError, "cannot write " + tmp};
     }
     std::error_code ec;
     std::filesystem::rename(tmp, config_.calibration_file, ec);
-    if (ec) return Error{"STORAGE_ERROR", "cannot write " + config_.calibration_file.string()};
+    if (ec) return Error{ErrorCode::kStorageError, "cannot write " + config_.calibration_file.string()};
 
     std::lock_guard lock(devices_mutex_);
     config_.station.calibration = report->calibration;

@@ -1,8 +1,8 @@
 #pragma once
 // DeviceStation: the Station of a configured turntable + depth camera (real or simulated) and the
-// measurement pipeline. A measurement captures a session pose by pose (progress "pose k of N"),
-// then measures it. MeasureSession works on a whole session, so processing starts right after
-// the capture rather than overlapping it.
+// measurement pipeline. A measurement captures a session pose by pose (progress "pose k of N");
+// each pose's first stage (PreparePose) runs on a PosePreparer while the table moves on, and the
+// rest of the recipe (MeasurePrepared), which needs every pose, runs after the last one.
 
 #include <atomic>
 #include <filesystem>
@@ -14,7 +14,7 @@
 #include "daemon/station.h"
 #include "drivers/driver_registry.h"
 #include "drivers/station_config.h"
-#include "pipeline/measure_pipeline.h"
+#include "pipeline/measure_config.h"
 
 namespace boxd {
 

@@ -24,28 +24,19 @@ const auto kProcessStart = std::chrono::steady_clock::now();
 // GET /v1/calibration lists this many of the latest calibrations.
 constexpr int kCalibrationHistoryShown = 20;
 
-void SetError(Response& res, int http_status, const std::string& code, const std::string& message) {
+// Answers {"error": {"code", "message"}} with `http_status`, by default the code's.
+void SetError(Response& res, int http_status, ErrorCode code, const std::string& message) {
     res.status = http_status;
-    res.set_content(json{{"error", {{"code", code}, {"message", message}}}}.dump(),
-                    "application/json");
+    res.set_content(
+        json{{"error", {{"code", ErrorCodeName(code)}, {"message", message}}}}.dump(),
+        "application/json");
 }
 
-// The HTTP status of a service or store error code.
-int HttpStatusOf(const std::string& code) {
-    if (code == kBusyCode) return 409;
-    if (code == "NOT_FOUND") return 404;
-    if (code == kShuttingDownCode) return 503;
-    if (code == "NOT_IMPLEMENTED") return 501;
-    // The session could not calibrate the station (wrong or moved reference, table not seen):
-    // the request was understood but its reference box cannot serve.
-    // The calibration refusal codes (calibration/station_calibrator.h), kept as strings so the
-    // API does not depend on the estimator.
-    for (const char* refusal : {"TOO_FEW_POSES", "TABLE_NOT_VISIBLE", "NO_REFERENCE",
-                                "WRONG_REFERENCE", "BOX_MOVED", "NOT_CONVERGED"}) {
-        if (code == refusal) return 422;
-    }
-    return 500;
+void SetError(Response& res, ErrorCode code, const std::string& message) {
+    SetError(res, HttpStatusOf(code), code, message);
 }
+
+void SetError(Response& res, const Error& error) { SetError(res, error.code, error.message); }
 
 void SetJson(Response& res, int http_status, const json& body) {
     res.status = http_status;
@@ -59,9 +50,9 @@ httplib::Server::Handler Guarded(std::function<void(const Request&, Response&)> 
             handler(req, res);
         } catch (const std::exception& e) {
             spdlog::error("{} {}: internal failure: {}", req.method, req.path, e.what());
-            SetError(res, 500, kInternalErrorCode, e.what());
+            SetError(res, ErrorCode::kInternal, e.what());
         } catch (...) {
-            SetError(res, 500, kInternalErrorCode, "unknown failure");
+            SetError(res, ErrorCode::kInternal, "unknown failure");
         }
     };
 }
@@ -90,16 +81,16 @@ std::optional<bool> BoolParam(const Request& req, const char* name) {
 std::optional<json> JsonObjectBody(const Request& req, Response& res, bool required) {
     if (req.body.empty()) {
         if (!required) return json::object();
-        SetError(res, 400, "BAD_REQUEST", "a JSON object body is required");
+        SetError(res, ErrorCode::kBadRequest, "a JSON object body is required");
         return std::nullopt;
     }
     json body = json::parse(req.body, nullptr, false);
     if (body.is_discarded()) {
-        SetError(res, 400, "BAD_REQUEST", "the body is not valid JSON");
+        SetError(res, ErrorCode::kBadRequest, "the body is not valid JSON");
         return std::nullopt;
     }
     if (!body.is_object()) {
-        SetError(res, 400, "BAD_REQUEST", "the body must be a JSON object");
+        SetError(res, ErrorCode::kBadRequest, "the body must be a JSON object");
         return std::nullopt;
     }
     return body;
@@ -181,7 +172,7 @@ void HttpApi::Register(httplib::Server& server) {
             return httplib::Server::HandlerResponse::Unhandled;
         }
         res.set_header("WWW-Authenticate", "Bearer");
-        SetError(res, 401, "UNAUTHORIZED", "POST requests need a valid bearer token");
+        SetError(res, ErrorCode::kUnauthorized, "POST requests need a valid bearer token");
         return httplib::Server::HandlerResponse::Handled;
     });
 
@@ -192,22 +183,25 @@ void HttpApi::Register(httplib::Server& server) {
             if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
             switch (res.status) {
                 case 404:
-                    SetError(res, 404, "NOT_FOUND", "no route " + req.method + " " + req.path);
+                    SetError(res, ErrorCode::kNotFound, "no route " + req.method + " " + req.path);
                     break;
                 case 413:
-                    SetError(res, 413, "PAYLOAD_TOO_LARGE", "the request body is too large");
+                    SetError(res, ErrorCode::kPayloadTooLarge, "the request body is too large");
                     break;
                 case 400:
-                    SetError(res, 400, "BAD_REQUEST", "malformed request");
+                    SetError(res, ErrorCode::kBadRequest, "malformed request");
                     break;
                 default:
-                    SetError(res, res.status, "HTTP_" + std::to_string(res.status),
+                    // Statuses the HTTP library sets itself (a range it cannot serve, a URI
+                    // too long): the status stays, the code is the category's.
+                    SetError(res, res.status,
+                             res.status < 500 ? ErrorCode::kBadRequest : ErrorCode::kInternal,
                              "the request failed with HTTP status " + std::to_string(res.status));
             }
             return httplib::Server::HandlerResponse::Handled;
         }));
     server.set_exception_handler([](const Request&, Response& res, std::exception_ptr) {
-        SetError(res, 500, kInternalErrorCode, "internal failure");
+        SetError(res, ErrorCode::kInternal, "internal failure");
     });
     server.set_logger([](const Request& req, const Response& res) {
         spdlog::debug("http {} {} -> {}", req.method, req.path, res.status);
@@ -215,7 +209,7 @@ void HttpApi::Register(httplib::Server& server) {
 
     server.Get("/v1/health", Guarded([this](const Request&, Response& res) {
                    if (loop_alive_ && !loop_alive_()) {
-                       SetError(res, 503, "LOOP_STALLED", "the service loop does not respond");
+                       SetError(res, ErrorCode::kLoopStalled, "the service loop does not respond");
                        return;
                    }
                    SetJson(res, 200, json{{"status", "ok"}});
@@ -228,14 +222,13 @@ void HttpApi::Register(httplib::Server& server) {
     server.Post("/v1/measure", Guarded([this](const Request& req, Response& res) {
                     const std::optional<bool> wait = BoolParam(req, "wait");
                     if (!wait) {
-                        SetError(res, 400, "BAD_REQUEST", "wait must be 0, 1, true or false");
+                        SetError(res, ErrorCode::kBadRequest, "wait must be 0, 1, true or false");
                         return;
                     }
                     if (!JsonObjectBody(req, res, false)) return;
                     Result<std::string> id = service_.Start();
                     if (!id) {
-                        SetError(res, HttpStatusOf(id.error().code), id.error().code,
-                                 id.error().message);
+                        SetError(res, id.error());
                         return;
                     }
                     res.set_header("Location", "/v1/measurements/" + *id);
@@ -247,11 +240,10 @@ void HttpApi::Register(httplib::Server& server) {
                         service_.WaitFor(*id, std::chrono::seconds(config_.wait_timeout_s));
                     if (result) {
                         SetJson(res, 200, *result);
-                    } else if (result.error().code == kTimeoutCode) {
+                    } else if (result.error().code == ErrorCode::kTimeout) {
                         SetJson(res, 202, json{{"id", *id}});  // still running: poll by id
                     } else {
-                        SetError(res, HttpStatusOf(result.error().code), result.error().code,
-                                 result.error().message);
+                        SetError(res, result.error());
                     }
                 }));
 
@@ -262,13 +254,13 @@ void HttpApi::Register(httplib::Server& server) {
                 const std::string v = req.get_param_value("limit");
                 const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), limit);
                 if (ec != std::errc() || end != v.data() + v.size() || limit < 1 || limit > 1000) {
-                    SetError(res, 400, "BAD_REQUEST", "limit must be an integer in 1..1000");
+                    SetError(res, ErrorCode::kBadRequest, "limit must be an integer in 1..1000");
                     return;
                 }
             }
             auto list = store_.List(limit);
             if (!list) {
-                SetError(res, 500, list.error().code, list.error().message);
+                SetError(res, list.error());
                 return;
             }
             SetJson(res, 200, json{{"measurements", *list}});
@@ -278,9 +270,9 @@ void HttpApi::Register(httplib::Server& server) {
                    const std::string id = req.matches[1];
                    auto m = id == "last" ? store_.Last() : store_.Get(id);
                    if (!m) {
-                       SetError(res, 500, m.error().code, m.error().message);
+                       SetError(res, m.error());
                    } else if (!*m) {
-                       SetError(res, 404, "NOT_FOUND",
+                       SetError(res, ErrorCode::kNotFound,
                                 id == "last" ? "no measurement yet" : "no measurement " + id);
                    } else {
                        SetJson(res, 200, **m);
@@ -292,17 +284,17 @@ void HttpApi::Register(httplib::Server& server) {
                    const std::string id = req.matches[1];
                    auto path = store_.CloudPath(id);
                    if (!path) {
-                       SetError(res, 500, path.error().code, path.error().message);
+                       SetError(res, path.error());
                        return;
                    }
                    if (!*path) {
-                       SetError(res, 404, "NOT_FOUND", "no cloud for measurement " + id);
+                       SetError(res, ErrorCode::kNotFound, "no cloud for measurement " + id);
                        return;
                    }
                    bool ok = false;
                    std::string data = ReadFile(**path, ok);
                    if (!ok || data.empty()) {
-                       SetError(res, 404, "NOT_FOUND", "the cloud of " + id + " is gone");
+                       SetError(res, ErrorCode::kNotFound, "the cloud of " + id + " is gone");
                        return;
                    }
                    res.set_header("Content-Disposition", "attachment; filename=\"" + id + ".ply\"");
@@ -319,7 +311,7 @@ void HttpApi::Register(httplib::Server& server) {
                                 ref[i].get<double>() < 5.0;
                     }
                     if (!valid) {
-                        SetError(res, 400, "BAD_REQUEST",
+                        SetError(res, ErrorCode::kBadRequest,
                                  "reference_m must be [L, W, H] in metres, each in (0, 5)");
                         return;
                     }
@@ -329,11 +321,10 @@ void HttpApi::Register(httplib::Server& server) {
                         service_.Calibrate(reference, std::chrono::seconds(config_.wait_timeout_s));
                     if (report) {
                         SetJson(res, 200, *report);
-                    } else if (report.error().code == kTimeoutCode) {
+                    } else if (report.error().code == ErrorCode::kTimeout) {
                         SetJson(res, 202, json{{"state", "calibrating"}});  // poll /v1/status
                     } else {
-                        SetError(res, HttpStatusOf(report.error().code), report.error().code,
-                                 report.error().message);
+                        SetError(res, report.error());
                     }
                 }));
 
@@ -366,7 +357,7 @@ Status HttpApi::Start() {
         }
         if (tcp_port_ <= 0) {
             tcp_port_ = 0;
-            return Error{"BIND_FAILED", "server.listen: cannot listen on " + config_.listen + ": " +
+            return Error{ErrorCode::kBindFailed, "server.listen: cannot listen on " + config_.listen + ": " +
                                             std::strerror(errno)};
         }
         servers_.push_back(std::move(server));
@@ -382,7 +373,7 @@ Status HttpApi::Start() {
         Register(*server);
         server->set_address_family(AF_UNIX);
         if (!server->bind_to_port(config_.unix_socket, 80)) {
-            return Error{"BIND_FAILED", "server.unix_socket: cannot listen on " +
+            return Error{ErrorCode::kBindFailed, "server.unix_socket: cannot listen on " +
                                             config_.unix_socket + ": " + std::strerror(errno)};
         }
         servers_.push_back(std::move(server));

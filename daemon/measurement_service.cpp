@@ -33,7 +33,7 @@ void LogMeasurement(const MeasurementResult& r) {
                      r.id, StatusName(r.status), d.length_m, d.width_m, d.height_m, d.volume_m3,
                      d.method, r.quality.poses, timing);
     } else {
-        const std::string why = r.reason ? r.reason->code + ": " + r.reason->message : "-";
+        const std::string why = r.reason ? ErrorCodeName(r.reason->code) + std::string(": ") + r.reason->message : "-";
         const auto level =
             r.status == MeasurementStatus::kFailed ? spdlog::level::err : spdlog::level::warn;
         spdlog::log(level, "measurement {} {}: {}, {} poses, {}", r.id, StatusName(r.status), why,
@@ -69,7 +69,7 @@ MeasurementService::MeasurementService(MeasurementStore& store, std::shared_ptr<
 }
 
 Result<std::vector<json>> MeasurementService::ListCalibrations(int limit) {
-    if (!history_) return Error{kStorageErrorCode, "the calibration history is not available"};
+    if (!history_) return Error{ErrorCode::kStorageError, "the calibration history is not available"};
     return history_->List(limit);
 }
 
@@ -115,7 +115,7 @@ std::shared_ptr<Station> MeasurementService::station() const {
 Status MeasurementService::ReplaceStation(std::shared_ptr<Station> station, bool keep_sessions) {
     {
         std::lock_guard lock(mutex_);
-        if (running_) return Error{kBusyCode, "a measurement is running"};
+        if (running_) return Error{ErrorCode::kBusy, "a measurement is running"};
         station_ = std::move(station);
         keep_sessions_ = keep_sessions;
         station_ok_ = false;
@@ -126,9 +126,9 @@ Status MeasurementService::ReplaceStation(std::shared_ptr<Station> station, bool
 
 Result<std::thread> MeasurementService::Claim(bool calibrating) {
     std::lock_guard lock(mutex_);
-    if (shutting_down_) return Error{kShuttingDownCode, "the daemon is stopping"};
+    if (shutting_down_) return Error{ErrorCode::kShuttingDown, "the daemon is stopping"};
     if (running_) {
-        return Error{kBusyCode, calibrating_ ? std::string("a calibration is running")
+        return Error{ErrorCode::kBusy, calibrating_ ? std::string("a calibration is running")
                                              : "measurement " + current_id_ + " is running"};
     }
     running_ = true;
@@ -181,7 +181,7 @@ JobOutput MeasurementService::RunStation(Station& station, const JobContext& ctx
         // must not take the service loop down with it.
         spdlog::critical("measurement {}: internal failure: {}", ctx.id, e.what());
         station.RequestStop();
-        return JobOutput{FailedResult(Error{kInternalErrorCode, e.what()}), {}};
+        return JobOutput{FailedResult(Error{ErrorCode::kInternal, e.what()}), {}};
     }
 }
 
@@ -214,11 +214,11 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (cancel_ && r.status != MeasurementStatus::kOk) {
         const std::string why =
-            r.reason ? " (" + r.reason->code + ": " + r.reason->message + ")" : std::string();
+            r.reason ? " (" + std::string(ErrorCodeName(r.reason->code)) + ": " + r.reason->message + ")" : std::string();
         r.status = MeasurementStatus::kFailed;
         r.dimensions.reset();
         r.reason =
-            MeasurementReason{kAbortedCode, "measurement aborted: the daemon is stopping" + why};
+            MeasurementReason{ErrorCode::kAborted, "measurement aborted: the daemon is stopping" + why};
     }
     const json result = ToJson(r);
     const Status saved = store_.Save(result, out.files);
@@ -250,7 +250,7 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
 struct MeasurementService::CalibrationRun {
     BoxDimensions reference;
     bool done = false;  // guarded by mutex_
-    Result<json> result = Error{kInternalErrorCode, "not run"};
+    Result<json> result = Error{ErrorCode::kInternal, "not run"};
 };
 
 Result<json> MeasurementService::Calibrate(const BoxDimensions& reference,
@@ -269,7 +269,7 @@ Result<json> MeasurementService::Calibrate(const BoxDimensions& reference,
     Notify();
     std::unique_lock lock(mutex_);
     if (!finished_cv_.wait_for(lock, timeout, [&] { return run->done; })) {
-        return Error{kTimeoutCode, "the calibration is still running"};
+        return Error{ErrorCode::kTimeout, "the calibration is still running"};
     }
     return run->result;
 }
@@ -285,7 +285,7 @@ void MeasurementService::RecordCalibration(const BoxDimensions& reference,
         record.quality = result->value("quality", json(nullptr));
         record.calibration = result->value("calibration", json(nullptr));
     } else {
-        record.error_code = result.error().code;
+        record.error_code = ErrorCodeName(result.error().code);
         record.error_message = result.error().message;
     }
     if (Status s = history_->Record(record); !s) {
@@ -305,22 +305,22 @@ void MeasurementService::RunCalibration(std::shared_ptr<CalibrationRun> run,
         }
         Notify();
     };
-    Result<json> result = Error{kInternalErrorCode, "not run"};
+    Result<json> result = Error{ErrorCode::kInternal, "not run"};
     try {
         Status opened = station->IsOpen() ? OkStatus() : station->Open();
         result = opened ? station->Calibrate(ctx, run->reference) : Result<json>(opened.error());
     } catch (const std::exception& e) {
         spdlog::critical("calibration: internal failure: {}", e.what());
         station->RequestStop();
-        result = Error{kInternalErrorCode, e.what()};
+        result = Error{ErrorCode::kInternal, e.what()};
     }
     if (!result && cancel_) {
-        result = Error{kAbortedCode, "calibration aborted: the daemon is stopping"};
+        result = Error{ErrorCode::kAborted, "calibration aborted: the daemon is stopping"};
     }
     if (result) {
         spdlog::info("calibration done: the new calibration is in force");
     } else {
-        spdlog::error("calibration failed: {}: {}", result.error().code, result.error().message);
+        spdlog::error("calibration failed: {}: {}", ErrorCodeName(result.error().code), result.error().message);
     }
     RecordCalibration(run->reference, result);
     const bool station_ok = station->IsOpen();
@@ -346,12 +346,12 @@ Result<json> MeasurementService::WaitFor(const std::string& id, std::chrono::mil
         std::unique_lock lock(mutex_);
         const bool done =
             finished_cv_.wait_for(lock, timeout, [&] { return !(running_ && current_id_ == id); });
-        if (!done) return Error{kTimeoutCode, "measurement " + id + " is still running"};
+        if (!done) return Error{ErrorCode::kTimeout, "measurement " + id + " is still running"};
         if (last_id_ == id) return last_result_;
     }
     auto stored = store_.Get(id);
     if (!stored) return stored.error();
-    if (!*stored) return Error{"NOT_FOUND", "no measurement " + id};
+    if (!*stored) return Error{ErrorCode::kNotFound, "no measurement " + id};
     return std::move(**stored);
 }
 

@@ -27,11 +27,6 @@ enum class ServiceState { kIdle, kMeasuring, kCalibrating, kError };
 const char* ServiceStateName(ServiceState s);
 
 // Error codes of the service (besides the station's and the store's).
-inline constexpr const char* kBusyCode = "BUSY";
-inline constexpr const char* kShuttingDownCode = "SHUTTING_DOWN";
-inline constexpr const char* kTimeoutCode = "TIMEOUT";
-inline constexpr const char* kAbortedCode = "ABORTED";
-inline constexpr const char* kInternalErrorCode = "INTERNAL_ERROR";
 
 struct ServiceSnapshot {
     ServiceState state = ServiceState::kIdle;

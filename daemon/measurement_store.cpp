@@ -14,7 +14,7 @@ using nlohmann::json;
 
 namespace {
 
-Error StorageError(const std::string& what) { return Error{kStorageErrorCode, what}; }
+Error StorageError(const std::string& what) { return Error{ErrorCode::kStorageError, what}; }
 
 // Ids are "m-" and at least six digits; anything else never reaches SQL or the file system.
 bool IsValidId(const std::string& id) {

@@ -19,7 +19,6 @@ struct sqlite3;
 
 namespace boxd {
 
-inline constexpr const char* kStorageErrorCode = "STORAGE_ERROR";
 
 // Files a finished measurement left in its scratch folder, moved into the store by Save().
 struct MeasurementFiles {

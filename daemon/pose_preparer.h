@@ -11,7 +11,7 @@
 #include <utility>
 #include <vector>
 
-#include "pipeline/measure_pipeline.h"
+#include "pipeline/prepare_pose.h"
 
 namespace boxd {
 

@@ -7,7 +7,7 @@ namespace boxd {
 Result<ServeConfig> LoadServeConfig(const std::filesystem::path& file,
                                     const ServeOverrides& overrides) {
     auto fail = [&file](const std::string& what) {
-        return Error{"INVALID_INPUT", file.string() + ": " + what};
+        return Error{ErrorCode::kInvalidInput, file.string() + ": " + what};
     };
     YAML::Node root;
     try {
@@ -36,13 +36,13 @@ Result<ServeConfig> LoadServeConfig(const std::filesystem::path& file,
     if (overrides.listen) {
         config.server.listen = *overrides.listen;
         if (Status s = config.server.Validate(); !s) {
-            return Error{"INVALID_INPUT", "--listen: " + s.error().message};
+            return Error{ErrorCode::kInvalidInput, "--listen: " + s.error().message};
         }
     }
     if (overrides.data_dir) {
         config.storage.data_dir = *overrides.data_dir;
         if (Status s = config.storage.Validate(); !s) {
-            return Error{"INVALID_INPUT", "--data-dir: " + s.error().message};
+            return Error{ErrorCode::kInvalidInput, "--data-dir: " + s.error().message};
         }
     }
     config.station.calibration_file =

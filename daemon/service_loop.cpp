@@ -13,7 +13,6 @@
 #include "daemon/measurement_service.h"
 #include "daemon/measurement_store.h"
 #include "daemon/signal_flags.h"
-#include "daemon/sim_turntable_process.h"
 #include "daemon/systemd_notifier.h"
 
 namespace boxd {
@@ -41,29 +40,12 @@ std::string StatusLine(const ServiceSnapshot& s) {
             return "measuring " + s.measurement_id + ": " + s.progress.stage + " pose " +
                    std::to_string(s.progress.pose) + "/" + std::to_string(s.progress.poses);
         case ServiceState::kError:
-            return "error: " + (s.last_error ? s.last_error->code + ": " + s.last_error->message
+            return "error: " + (s.last_error ? ErrorCodeName(s.last_error->code) + std::string(": ") + s.last_error->message
                                              : std::string("devices not ready"));
         default:
             return std::string(ServiceStateName(s.state)) +
                    (s.last_measurement_id.empty() ? "" : ", last " + s.last_measurement_id);
     }
-}
-
-// "simulated" turntables run as a `boxd sim-turntable` child process; the daemon then drives it
-// as the Modbus TCP drive it is. Starts the child once and points `config` at it.
-Status UseSimulatedTurntable(ServeConfig& config, std::unique_ptr<SimTurntableProcess>& child) {
-    TurntableConfig& table = config.station.station.turntable;
-    if (table.driver != "simulated") return OkStatus();
-    if (!child) {
-        auto started = SimTurntableProcess::Start(CurrentExecutable(), table.port,
-                                                  std::max(90.0, table.speed_dps));
-        if (!started) return started.error();
-        child = std::move(*started);
-    }
-    table.driver = "modbus-tcp";
-    table.host = "127.0.0.1";
-    table.port = child->port();
-    return OkStatus();
 }
 
 class ServiceLoop {
@@ -86,7 +68,6 @@ private:
     std::filesystem::path config_file_;
     ServeOverrides overrides_;
     SystemdNotifier notifier_;
-    std::unique_ptr<SimTurntableProcess> sim_child_;
     std::unique_ptr<MeasurementStore> store_;
     std::unique_ptr<MeasurementService> service_;
     std::unique_ptr<HttpApi> api_;
@@ -104,10 +85,6 @@ long long NowMs() {
 int ServiceLoop::Run() {
     if (!InstallSignalFlags()) {
         spdlog::critical("cannot install the signal handlers");
-        return kExitInternal;
-    }
-    if (Status s = UseSimulatedTurntable(config_, sim_child_); !s) {
-        spdlog::critical("{}", s.error().message);
         return kExitInternal;
     }
     auto store = MeasurementStore::Open(config_.storage.data_dir, config_.storage.retention);
@@ -167,7 +144,6 @@ int ServiceLoop::Run() {
     api_->Stop();
     api_.reset();
     service_.reset();
-    sim_child_.reset();
     spdlog::info("stopped");
     return 0;
 }
@@ -204,11 +180,6 @@ void ServiceLoop::Reload() {
     if (fresh->storage.data_dir != config_.storage.data_dir) {
         spdlog::warn("reload: storage.data_dir changes take effect at the next restart");
         fresh->storage.data_dir = config_.storage.data_dir;
-    }
-    if (Status s = UseSimulatedTurntable(*fresh, sim_child_); !s) {
-        spdlog::error("reload failed, keeping the running config: {}", s.error().message);
-        notifier_.Ready(StatusLine(service_->Snapshot()));
-        return;
     }
     store_->set_retention(fresh->storage.retention);
     // The old station lets go of the devices before the new one opens them.

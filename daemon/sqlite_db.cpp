@@ -5,13 +5,13 @@
 namespace boxd {
 
 Error SqlError(sqlite3* db, const std::string& what) {
-    return Error{kStorageErrorCode, what + ": " + sqlite3_errmsg(db)};
+    return Error{ErrorCode::kStorageError, what + ": " + sqlite3_errmsg(db)};
 }
 
 Status SqlExec(sqlite3* db, const char* sql) {
     char* err = nullptr;
     if (sqlite3_exec(db, sql, nullptr, nullptr, &err) != SQLITE_OK) {
-        Error e{kStorageErrorCode, std::string(sql).substr(0, 40) + "...: " + (err ? err : "?")};
+        Error e{ErrorCode::kStorageError, std::string(sql).substr(0, 40) + "...: " + (err ? err : "?")};
         sqlite3_free(err);
         return e;
     }
@@ -47,10 +47,10 @@ Result<sqlite3*> OpenDatabase(const std::filesystem::path& data_dir,
         SqlStatement mode(db, "PRAGMA journal_mode;");
         wal = mode.prepared() && mode.Step() == SQLITE_ROW && mode.Text(0) == "wal";
     }
-    if (!wal) return fail(Error{kStorageErrorCode, path.string() + ": cannot switch to WAL mode"});
+    if (!wal) return fail(Error{ErrorCode::kStorageError, path.string() + ": cannot switch to WAL mode"});
     for (const char* sql : schema) {
         if (auto s = SqlExec(db, sql); !s) {
-            return fail(Error{kStorageErrorCode, path.string() + ": " + s.error().message});
+            return fail(Error{ErrorCode::kStorageError, path.string() + ": " + s.error().message});
         }
     }
     return db;

@@ -14,7 +14,7 @@ namespace boxd {
 namespace {
 
 Error ConfigError(const std::string& field, const std::string& what) {
-    return Error{"INVALID_INPUT", "capture." + field + ": " + what};
+    return Error{ErrorCode::kInvalidInput, "capture." + field + ": " + what};
 }
 
 // Forwards a cancel flag to the turntable while a capture runs: a move in progress is stopped
@@ -122,7 +122,7 @@ Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
     const auto timeout = std::chrono::milliseconds(config.grab_timeout_ms);
     auto cancelled = [&](int pose) -> Error {
         StopTable(turntable);
-        return Error{kCancelledErrorCode, "capture cancelled at pose " + std::to_string(pose + 1) +
+        return Error{ErrorCode::kCancelled, "capture cancelled at pose " + std::to_string(pose + 1) +
                                               " of " + std::to_string(n) +
                                               "; the table was stopped"};
     };
@@ -147,7 +147,7 @@ Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
             auto frame = camera.Grab(timeout);
             if (!frame) {
                 StopTable(turntable);
-                return Error{kCameraErrorCode, "pose " + std::to_string(k + 1) + " of " +
+                return Error{ErrorCode::kCameraError, "pose " + std::to_string(k + 1) + " of " +
                                                    std::to_string(n) + ": " +
                                                    frame.error().message};
             }

@@ -14,7 +14,6 @@
 
 namespace boxd {
 
-inline constexpr const char* kCancelledErrorCode = "CANCELLED";
 
 // The `capture:` section.
 struct CaptureConfig {

@@ -16,11 +16,10 @@
 
 namespace boxd {
 
-inline constexpr const char* kCameraErrorCode = "CAMERA_ERROR";
 
 // Returns a CAMERA_ERROR carrying `message`.
 inline Error CameraError(std::string message) {
-    return Error{kCameraErrorCode, std::move(message)};
+    return Error{ErrorCode::kCameraError, std::move(message)};
 }
 
 class DepthCamera {

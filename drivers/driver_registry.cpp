@@ -6,7 +6,7 @@
 #include "drivers/openni2_camera.h"
 #include "drivers/replay_camera.h"
 #include "drivers/replay_turntable.h"
-#include "drivers/simulated_camera.h"
+#include "drivers/sim/simulated_camera.h"
 
 namespace boxd {
 

@@ -1,49 +1,42 @@
 // MakeTurntable: picks the Turntable implementation that `turntable.driver` names.
-#include <spdlog/spdlog.h>
-
-#include <atomic>
-#include <thread>
+#include <algorithm>
 
 #include "drivers/modbus_turntable.h"
+#include "drivers/sim/sim_turntable_process.h"
 #include "drivers/turntable.h"
-#include "drivers/turntable_simulator.h"
 
 namespace boxd {
 
 namespace {
 
-// "simulated": a TurntableSimulator serving Modbus TCP on a thread of this process, driven by
-// the ordinary ModbusTurntable over loopback — the same code path as a real drive.
+// "simulated": `boxd sim-turntable` as a child process (SimTurntableProcess), driven by the
+// ordinary ModbusTurntable over loopback — the same code path as a real drive.
 class SimulatedTurntable : public Turntable {
 public:
     static Result<std::unique_ptr<Turntable>> Start(const TurntableConfig& config) {
-        std::unique_ptr<SimulatedTurntable> table(new SimulatedTurntable());
-        TurntableSimulatorConfig sim;
-        // The simulated drive is fast enough for any configured speed; the speed register
+        SimTurntableLaunch launch;
+        launch.binary = config.simulator_binary;
+        launch.port = config.port;
+        // The simulated drive's top speed allows any configured speed; the speed register
         // (from turntable.speed_dps) sets the pace.
-        sim.max_speed_dps = std::max(sim.max_speed_dps, config.speed_dps);
-        table->simulator_ = std::make_unique<TurntableSimulator>(sim);
-        if (auto st = table->simulator_->ListenTcp(config.host, config.port); !st) {
-            return Error{kTurntableErrorCode, "simulated turntable: " + st.error().message};
-        }
-        table->thread_ = std::thread([t = table.get()] {
-            if (auto st = t->simulator_->Serve(t->stop_server_); !st) {
-                spdlog::error("{}", st.error().message);
-            }
-        });
+        launch.args = {"--speed-dps", std::to_string(std::max(90.0, config.speed_dps))};
+        auto process = SimTurntableProcess::Start(launch);
+        if (!process) return process.error();
         TurntableConfig client = config;
         client.driver = "modbus-tcp";
-        client.port = table->simulator_->port();
+        client.host = "127.0.0.1";
+        client.port = (*process)->port();
         auto driver = ModbusTurntable::Open(client);
         if (!driver) return driver.error();
+        std::unique_ptr<SimulatedTurntable> table(new SimulatedTurntable());
+        table->process_ = std::move(*process);
         table->driver_ = std::move(*driver);
         return std::unique_ptr<Turntable>(std::move(table));
     }
 
     ~SimulatedTurntable() override {
-        driver_.reset();
-        stop_server_.store(true);
-        if (thread_.joinable()) thread_.join();
+        driver_.reset();  // the client lets go of the connection before the server stops
+        process_.reset();
     }
 
     Status Home() override { return driver_->Home(); }
@@ -58,9 +51,7 @@ public:
 private:
     SimulatedTurntable() = default;
 
-    std::unique_ptr<TurntableSimulator> simulator_;
-    std::atomic<bool> stop_server_{false};
-    std::thread thread_;
+    std::unique_ptr<SimTurntableProcess> process_;
     std::unique_ptr<ModbusTurntable> driver_;
 };
 

@@ -65,7 +65,7 @@ std::string ModbusClient::Describe() const {
 Status ModbusClient::Connect() {
     std::string why;
     if (OpenLink(why)) return OkStatus();
-    return Error{kTurntableErrorCode, Describe() + ": " + why};
+    return Error{ErrorCode::kTurntableError, Describe() + ": " + why};
 }
 
 bool ModbusClient::OpenLink(std::string& why) {
@@ -123,7 +123,7 @@ Status ModbusClient::Transact(const std::string& what, Fn&& fn) {
                 last_error = std::string("Modbus exception: ") + modbus_strerror(err);
                 continue;
             }
-            return Error{kTurntableErrorCode, Describe() + ": " + what +
+            return Error{ErrorCode::kTurntableError, Describe() + ": " + what +
                                                   ": the drive answered with a Modbus exception: " +
                                                   modbus_strerror(err)};
         }
@@ -131,7 +131,7 @@ Status ModbusClient::Transact(const std::string& what, Fn&& fn) {
         last_error = ErrnoText(err, config_.response_timeout_ms);
         Close();
     }
-    return Error{kTurntableErrorCode,
+    return Error{ErrorCode::kTurntableError,
                  Describe() + ": " + what + " failed after " + std::to_string(attempts) +
                      (attempts == 1 ? " attempt: " : " attempts: ") + last_error};
 }

@@ -48,7 +48,7 @@ ModbusTurntable::ModbusTurntable(const TurntableConfig& config)
 Result<std::unique_ptr<ModbusTurntable>> ModbusTurntable::Open(const TurntableConfig& config) {
     if (auto st = config.Validate(); !st) return st.error();
     if (config.driver != "modbus-tcp" && config.driver != "modbus-rtu") {
-        return Error{"INVALID_INPUT",
+        return Error{ErrorCode::kInvalidInput,
                      "turntable.driver: ModbusTurntable needs modbus-tcp or "
                      "modbus-rtu, got '" +
                          config.driver + "'"};
@@ -60,7 +60,7 @@ Result<std::unique_ptr<ModbusTurntable>> ModbusTurntable::Open(const TurntableCo
 }
 
 Error ModbusTurntable::Fail(const std::string& message) const {
-    return Error{kTurntableErrorCode, Describe() + ": " + message};
+    return Error{ErrorCode::kTurntableError, Describe() + ": " + message};
 }
 
 Result<TurntableState> ModbusTurntable::State() {

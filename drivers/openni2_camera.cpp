@@ -15,7 +15,7 @@ namespace boxd {
 namespace {
 
 Error ConfigError(const std::string& field, const std::string& what) {
-    return Error{"INVALID_INPUT", "camera.openni2." + field + ": " + what};
+    return Error{ErrorCode::kInvalidInput, "camera.openni2." + field + ": " + what};
 }
 
 // OpenNI2 keeps global driver state; it is initialised once per process and never shut down,

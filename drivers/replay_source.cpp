@@ -14,7 +14,7 @@ constexpr double kAngleMatchDeg = 0.01;
 
 Status ReplayConfig::Validate() const {
     if (session.empty()) {
-        return Error{"INVALID_INPUT", "camera.replay.session: must name a session folder"};
+        return Error{ErrorCode::kInvalidInput, "camera.replay.session: must name a session folder"};
     }
     return OkStatus();
 }

@@ -9,7 +9,7 @@ ReplayTurntable::ReplayTurntable(std::shared_ptr<ReplaySource> source)
     : source_(std::move(source)) {}
 
 Status ReplayTurntable::Home() {
-    if (stop_requested_.load()) return Error{kTurntableErrorCode, "replay: stop requested"};
+    if (stop_requested_.load()) return Error{ErrorCode::kTurntableError, "replay: stop requested"};
     angle_deg_ = 0.0;
     homed_ = true;
     if (auto pose = source_->FindPose(0.0)) source_->SelectPose(*pose);
@@ -19,14 +19,14 @@ Status ReplayTurntable::Home() {
 Status ReplayTurntable::MoveTo(double angle_deg) {
     if (stop_requested_.load()) {
         Stop().ok();
-        return Error{kTurntableErrorCode, "replay: stop requested"};
+        return Error{ErrorCode::kTurntableError, "replay: stop requested"};
     }
     const auto pose = source_->FindPose(angle_deg);
     if (!pose) {
         std::ostringstream msg;
         msg << "replay: the session has no pose at " << angle_deg
             << " deg (recorded angles: " << source_->AngleList() << ")";
-        return Error{kTurntableErrorCode, msg.str()};
+        return Error{ErrorCode::kTurntableError, msg.str()};
     }
     source_->SelectPose(*pose);
     angle_deg_ = angle_deg;

@@ -14,7 +14,7 @@ namespace boxd {
 namespace {
 
 Error KeyError(const std::string& key, const std::string& what) {
-    return Error{"INVALID_INPUT", key + ": " + what};
+    return Error{ErrorCode::kInvalidInput, key + ": " + what};
 }
 
 // One YAML key: how to read its value, given the node and the key's full dotted name.
@@ -144,7 +144,7 @@ Status CameraConfig::Validate() const {
     }
     if (intrinsics) {
         if (auto st = intrinsics->Validate("camera.intrinsics"); !st) {
-            return Error{"INVALID_INPUT", st.error().message};
+            return Error{ErrorCode::kInvalidInput, st.error().message};
         }
     }
     if (driver == "openni2") return openni2.Validate();
@@ -223,7 +223,7 @@ Result<StationCalibration> ParseCalibration(const YAML::Node& node) {
         return st.error();
     }
     if (auto st = c.Validate("calibration"); !st) {
-        return Error{"INVALID_INPUT", st.error().message};
+        return Error{ErrorCode::kInvalidInput, st.error().message};
     }
     return c;
 }
@@ -232,7 +232,7 @@ Result<StationConfig> ParseStationConfig(const YAML::Node& document) {
     const YAML::Node& root = document;  // const: lookups must not add keys
     StationConfig config;
     if (root && !root.IsNull() && !root.IsMap()) {
-        return Error{"INVALID_INPUT", "config: must be a map of sections"};
+        return Error{ErrorCode::kInvalidInput, "config: must be a map of sections"};
     }
     for (const auto& item : root) {
         const std::string name = item.first.Scalar();
@@ -264,13 +264,13 @@ Result<StationConfig> LoadStationConfig(const std::filesystem::path& path) {
     try {
         root = YAML::LoadFile(path.string());
     } catch (const YAML::BadFile&) {
-        return Error{"INVALID_INPUT", path.string() + ": cannot read the config file"};
+        return Error{ErrorCode::kInvalidInput, path.string() + ": cannot read the config file"};
     } catch (const YAML::Exception& e) {
-        return Error{"INVALID_INPUT",
+        return Error{ErrorCode::kInvalidInput,
                      path.string() + ": line " + std::to_string(e.mark.line + 1) + ": " + e.msg};
     }
     auto config = ParseStationConfig(root);
-    if (!config) return Error{"INVALID_INPUT", path.string() + ": " + config.error().message};
+    if (!config) return Error{ErrorCode::kInvalidInput, path.string() + ": " + config.error().message};
     // A relative replay session path is relative to the config file, not the working folder.
     std::string& session = config->camera.replay.session;
     if (!session.empty() && std::filesystem::path(session).is_relative()) {

@@ -11,7 +11,7 @@
 #include "drivers/capture_loop.h"
 #include "drivers/openni2_camera.h"
 #include "drivers/replay_source.h"
-#include "drivers/simulated_camera.h"
+#include "drivers/sim/simulated_camera.h"
 #include "drivers/turntable.h"
 #include "pipeline/station_calibration.h"
 

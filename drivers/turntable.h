@@ -29,7 +29,6 @@ class Node;
 
 namespace boxd {
 
-inline constexpr const char* kTurntableErrorCode = "TURNTABLE_ERROR";
 
 // A snapshot of the drive, read in one go from its status registers.
 struct TurntableState {
@@ -68,9 +67,12 @@ public:
 
 // The `turntable:` section of the YAML config (field names are the YAML keys).
 struct TurntableConfig {
-    // "modbus-tcp", "modbus-rtu", or "simulated" (an in-process `boxd sim-turntable` server on
-    // host:port — port 0 picks a free one — driven over real Modbus TCP).
+    // "modbus-tcp", "modbus-rtu", or "simulated" (a `boxd sim-turntable` child process on
+    // 127.0.0.1:port — port 0 picks a free one — driven over real Modbus TCP).
     std::string driver = "modbus-tcp";
+    // The executable that serves `sim-turntable` for the "simulated" driver; empty: the running
+    // boxd itself.
+    std::string simulator_binary;
     // Modbus TCP.
     std::string host = "127.0.0.1";
     int port = 5020;

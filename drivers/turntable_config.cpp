@@ -12,7 +12,7 @@ namespace boxd {
 namespace {
 
 Error ConfigError(const std::string& field, const std::string& what) {
-    return Error{"INVALID_INPUT", "turntable." + field + ": " + what};
+    return Error{ErrorCode::kInvalidInput, "turntable." + field + ": " + what};
 }
 
 Status CheckRange(const char* field, int value, int lo, int hi) {
@@ -75,7 +75,7 @@ Status ParseFaultNames(const YAML::Node& node, const std::string& field,
 Status ApplyMap(const YAML::Node& node, const std::string& prefix,
                 const std::map<std::string, Setter>& setters) {
     if (!node.IsMap()) {
-        return Error{"INVALID_INPUT", "turntable" + prefix + ": must be a map"};
+        return Error{ErrorCode::kInvalidInput, "turntable" + prefix + ": must be a map"};
     }
     for (const auto& item : node) {
         const std::string key = item.first.Scalar();
@@ -193,6 +193,7 @@ Result<TurntableConfig> ParseTurntableConfig(const YAML::Node& node) {
         {"angle_tolerance_deg", Field(c.angle_tolerance_deg)},
         {"speed_dps", Field(c.speed_dps)},
         {"direction", Field(c.direction)},
+        {"simulator_binary", Field(c.simulator_binary)},
         {"profile",
          [&c](const YAML::Node& n, const std::string&) { return ParseProfile(n, c.profile); }},
     };

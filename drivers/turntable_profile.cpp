@@ -8,7 +8,7 @@ namespace boxd {
 namespace {
 
 Error ProfileError(const std::string& field, const std::string& what) {
-    return Error{"INVALID_INPUT", "turntable.profile." + field + ": " + what};
+    return Error{ErrorCode::kInvalidInput, "turntable.profile." + field + ": " + what};
 }
 
 // A register holding `count` consecutive words must fit in the 16-bit Modbus address space.
@@ -62,20 +62,6 @@ Status TurntableProfile::Validate() const {
         return ProfileError("angle_units_per_deg", "must be a non-zero number");
     }
     return OkStatus();
-}
-
-void SplitInt32(int32_t value, WordOrder order, uint16_t out[2]) {
-    const auto bits = static_cast<uint32_t>(value);
-    const auto high = static_cast<uint16_t>(bits >> 16);
-    const auto low = static_cast<uint16_t>(bits & 0xFFFFu);
-    out[0] = order == WordOrder::kHighFirst ? high : low;
-    out[1] = order == WordOrder::kHighFirst ? low : high;
-}
-
-int32_t JoinInt32(const uint16_t in[2], WordOrder order) {
-    const uint32_t high = order == WordOrder::kHighFirst ? in[0] : in[1];
-    const uint32_t low = order == WordOrder::kHighFirst ? in[1] : in[0];
-    return static_cast<int32_t>((high << 16) | low);
 }
 
 std::string DescribeFaultCode(const TurntableProfile& profile, int code) {

@@ -53,9 +53,19 @@ struct TurntableProfile {
 };
 
 // Splits a signed 32-bit value into two registers in `order`.
-void SplitInt32(int32_t value, WordOrder order, uint16_t out[2]);
+inline void SplitInt32(int32_t value, WordOrder order, uint16_t out[2]) {
+    const auto bits = static_cast<uint32_t>(value);
+    const auto high = static_cast<uint16_t>(bits >> 16);
+    const auto low = static_cast<uint16_t>(bits & 0xFFFFu);
+    out[0] = order == WordOrder::kHighFirst ? high : low;
+    out[1] = order == WordOrder::kHighFirst ? low : high;
+}
 // Joins two registers in `order` into a signed 32-bit value.
-int32_t JoinInt32(const uint16_t in[2], WordOrder order);
+inline int32_t JoinInt32(const uint16_t in[2], WordOrder order) {
+    const uint32_t high = order == WordOrder::kHighFirst ? in[0] : in[1];
+    const uint32_t low = order == WordOrder::kHighFirst ? in[1] : in[0];
+    return static_cast<int32_t>((high << 16) | low);
+}
 
 // Returns "stall (code 1)" for a named code, "code 7" for an unnamed one.
 std::string DescribeFaultCode(const TurntableProfile& profile, int code);

@@ -13,7 +13,7 @@ namespace boxd {
 namespace {
 
 Status Bad(const std::string& field, const std::string& why) {
-    return Error{"INVALID_CONFIG", "box_fit." + field + ": " + why};
+    return Error{ErrorCode::kInvalidConfig, "box_fit." + field + ": " + why};
 }
 
 double Median(std::vector<double> v) {
@@ -64,7 +64,7 @@ Result<BoxState> SeedFootprint(const Points& points, const BoxFitConfig& config)
                              static_cast<float>((iy + 0.5) * config.footprint_cell_m));
     }
     if (centres.size() < 3) {
-        return Error{"OBJECT_TOO_SMALL", "the object's footprint is too small to measure"};
+        return Error{ErrorCode::kObjectTooSmall, "the object's footprint is too small to measure"};
     }
     // Order-independent input for minAreaRect: sort the centres (the hash map order is not).
     std::sort(centres.begin(), centres.end(), [](const cv::Point2f& a, const cv::Point2f& b) {
@@ -235,7 +235,7 @@ Status BoxFitConfig::Validate() const {
 }
 
 Result<BoxFit> FitFootprintBox(const Points& points, const BoxFitConfig& config) {
-    if (points.size() < 10) return Error{"OBJECT_TOO_SMALL", "too few object points"};
+    if (points.size() < 10) return Error{ErrorCode::kObjectTooSmall, "too few object points"};
     auto seeded = SeedFootprint(points, config);
     if (!seeded) return seeded.error();
     BoxState s = *seeded;
@@ -250,7 +250,7 @@ Result<BoxFit> FitFootprintBox(const Points& points, const BoxFitConfig& config)
     const double min_side = std::min(s.d[0] + s.d[1], s.d[2] + s.d[3]);
     if (min_side < 2.0 * config.edge_margin_m + 0.01 ||
         s.height < 2.0 * config.edge_margin_m + 0.005) {
-        return Error{"OBJECT_TOO_SMALL", "the object is too small to measure"};
+        return Error{ErrorCode::kObjectTooSmall, "the object is too small to measure"};
     }
     std::array<double, 4> band;
     band.fill(config.initial_band_m);
@@ -258,10 +258,10 @@ Result<BoxFit> FitFootprintBox(const Points& points, const BoxFitConfig& config)
     std::array<int, 5> counts{};
     for (int it = 0; it < config.iterations; ++it) {
         if (!FitTop(points, config, top_band, s, counts)) {
-            return Error{"INSUFFICIENT_DATA", "the top face is not observed well enough"};
+            return Error{ErrorCode::kInsufficientData, "the top face is not observed well enough"};
         }
         if (!FitSides(points, config, band, s, counts)) {
-            return Error{"INSUFFICIENT_DATA",
+            return Error{ErrorCode::kInsufficientData,
                          "a side face of the object is not observed well enough"};
         }
         for (std::size_t k = 0; k < 4; ++k) {
@@ -272,7 +272,7 @@ Result<BoxFit> FitFootprintBox(const Points& points, const BoxFitConfig& config)
             std::clamp(config.band_sigmas * s.sigma[4], config.min_band_m, config.initial_band_m);
     }
     if (!FitTop(points, config, top_band, s, counts)) {
-        return Error{"INSUFFICIENT_DATA", "the top face is not observed well enough"};
+        return Error{ErrorCode::kInsufficientData, "the top face is not observed well enough"};
     }
     BoxFit fit;
     const double len_u = s.d[0] + s.d[1], len_v = s.d[2] + s.d[3];

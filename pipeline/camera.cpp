@@ -12,7 +12,7 @@ bool PositiveFinite(double v) { return std::isfinite(v) && v > 0.0; }
 
 Status CameraIntrinsics::Validate(const std::string& where) const {
     auto bad = [&](const std::string& field, const std::string& why) -> Status {
-        return Error{"INVALID_INPUT", where + "." + field + ": " + why};
+        return Error{ErrorCode::kInvalidInput, where + "." + field + ": " + why};
     };
     if (width <= 0 || width > 8192) return bad("width", "must be in 1..8192");
     if (height <= 0 || height > 8192) return bad("height", "must be in 1..8192");

@@ -9,7 +9,7 @@ namespace boxd {
 namespace {
 
 Status Bad(const std::string& field, const std::string& why) {
-    return Error{"INVALID_CONFIG", field + ": " + why};
+    return Error{ErrorCode::kInvalidConfig, field + ": " + why};
 }
 
 bool NonNegative(double v) { return std::isfinite(v) && v >= 0.0; }
@@ -40,12 +40,12 @@ Status FlyingPixelConfig::Validate() const {
 
 Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, double depth_unit_m,
                                     const AveragingConfig& config) {
-    if (frames.empty()) return Error{"INSUFFICIENT_DATA", "no frames to average"};
+    if (frames.empty()) return Error{ErrorCode::kInsufficientData, "no frames to average"};
     const int w = frames[0].width, h = frames[0].height;
     for (const DepthImage& f : frames) {
         if (f.width != w || f.height != h ||
             f.pixels.size() != static_cast<std::size_t>(w) * static_cast<std::size_t>(h)) {
-            return Error{"INSUFFICIENT_DATA", "frames of one pose differ in size"};
+            return Error{ErrorCode::kInsufficientData, "frames of one pose differ in size"};
         }
     }
     const std::size_t n = frames.size();

@@ -8,7 +8,7 @@ namespace boxd {
 
 Status FusionConfig::Validate() const {
     auto bad = [](const std::string& f, const std::string& why) -> Status {
-        return Error{"INVALID_CONFIG", "fusion." + f + ": " + why};
+        return Error{ErrorCode::kInvalidConfig, "fusion." + f + ": " + why};
     };
     if (!(support_voxel_m > 0.0005 && support_voxel_m < 0.1)) {
         return bad("support_voxel_m", "must be in (0.0005, 0.1)");

@@ -15,7 +15,7 @@ int IcpTarget::Nearest(const Eigen::Vector3f& p, float max_dist) const {
 
 Status IcpConfig::Validate(const std::string& where) const {
     auto bad = [&](const std::string& f, const std::string& why) -> Status {
-        return Error{"INVALID_CONFIG", where + "." + f + ": " + why};
+        return Error{ErrorCode::kInvalidConfig, where + "." + f + ": " + why};
     };
     if (!(max_correspondence_m > 0.0 && max_correspondence_m < 1.0)) {
         return bad("max_correspondence_m", "must be in (0, 1)");

@@ -7,27 +7,15 @@
 #include <optional>
 #include <string>
 
+#include "pipeline/result.h"
+
 namespace boxd {
 
 enum class MeasurementStatus { kOk, kNoDim, kFailed };
 
-// The spec's no-dimension reason codes.
-namespace reason {
-inline constexpr const char* kNoObject = "NO_OBJECT";
-inline constexpr const char* kObjectTooSmall = "OBJECT_TOO_SMALL";
-inline constexpr const char* kObjectTooLarge = "OBJECT_TOO_LARGE";
-inline constexpr const char* kRegistrationFailed = "REGISTRATION_FAILED";
-inline constexpr const char* kObjectMoved = "OBJECT_MOVED";
-inline constexpr const char* kInsufficientData = "INSUFFICIENT_DATA";
-inline constexpr const char* kCameraError = "CAMERA_ERROR";
-inline constexpr const char* kTurntableError = "TURNTABLE_ERROR";
-inline constexpr const char* kNotCalibrated = "NOT_CALIBRATED";
-}  // namespace reason
-
-struct MeasurementReason {
-    std::string code;
-    std::string message;
-};
+// Why a measurement gave no dimension (status no_dim) or failed: a code of the no-dimension,
+// device or interrupted categories and a one-line message.
+using MeasurementReason = Error;
 
 struct MeasuredDimensions {
     double length_m = 0.0;

@@ -10,7 +10,7 @@ Status WritePly(const std::filesystem::path& path, const Points& points) {
     static_assert(std::endian::native == std::endian::little,
                   "binary_little_endian PLY is written from native floats");
     std::ofstream out(path, std::ios::binary);
-    if (!out) return Error{"IO_ERROR", "cannot open " + path.string() + " for writing"};
+    if (!out) return Error{ErrorCode::kIoError, "cannot open " + path.string() + " for writing"};
     out << "ply\nformat binary_little_endian 1.0\ncomment boxd fused cloud, table frame, metres\n"
         << "element vertex " << points.size() << "\n"
         << "property float x\nproperty float y\nproperty float z\nend_header\n";
@@ -19,7 +19,7 @@ Status WritePly(const std::filesystem::path& path, const Points& points) {
         out.write(reinterpret_cast<const char*>(xyz), sizeof(xyz));
     }
     out.close();
-    if (!out) return Error{"IO_ERROR", "failed writing " + path.string()};
+    if (!out) return Error{ErrorCode::kIoError, "failed writing " + path.string()};
     return OkStatus();
 }
 

@@ -17,8 +17,16 @@ T NormalizeAngle(const T& a) {
     return a - two_pi * ceres::floor((a + T(M_PI)) / two_pi);
 }
 
-// Residual of a relative measurement: the left perturbation taking the measured motion onto the
-// predicted one, pred = X_from⁻¹ ∘ X_to, weighted by the square-root information.
+// Residual of a relative measurement (an ICP edge), in the manner of Ceres'
+// examples/slam/pose_graph_2d. Poses are X = (t, θ) in SE(2), mapping a view's points into the
+// frame of pose 0: p0 = R(θ) p + t. The edge measured M = (t_m, θ_m), the motion taking view
+// `to` into view `from`; the poses predict
+//     P = X_from⁻¹ ∘ X_to = ( R(θ_a)ᵀ (t_b − t_a),  θ_b − θ_a ).
+// The error is the left perturbation that takes the measurement onto the prediction,
+//     D = P ∘ M⁻¹:   δθ = wrap(θ_P − θ_m),   δt = t_P − R(δθ) t_m,
+// which is zero exactly when P = M, and the residual is r = U (δt, δθ) with UᵀU the edge's
+// information (PoseEdge::information, same left-perturbation coordinates), so that
+// |r|² = eᵀ Λ e, the Mahalanobis distance of the edge.
 class RelativeCost {
 public:
     RelativeCost(const Se2& measured, const Eigen::Matrix3d& sqrt_information)
@@ -54,9 +62,15 @@ private:
     Eigen::Matrix3d sqrt_info_;
 };
 
-// Turntable model prior: node k is a rotation by its commanded yaw about the common centre c,
-// pose = c - R(yaw) c. The translation part uses the node's own yaw so that the turntable's angle
-// error does not leak into the translation.
+// Turntable model prior. A turntable turns every view about one centre c of the table plane:
+// node k is the rotation by θ_k about c,
+//     X_k = ( c − R(θ_k) c,  θ_k ),
+// so the prior's residual is
+//     r = ( (t_k − (c − R(θ_k) c)) / σ_c,  wrap(θ_k − θ_commanded) / σ_θ ).
+// The translation part uses the node's own yaw θ_k (not the commanded one), so that the table's
+// angle error (σ_θ, a few tenths of a degree) does not leak into the translation; σ_c is how far
+// a view may sit off the pure rotation (the calibration's in-plane centre error is absorbed by c,
+// which is a free parameter of the problem).
 class TurntablePriorCost {
 public:
     TurntablePriorCost(double commanded_yaw, double yaw_sigma, double center_sigma)
@@ -119,6 +133,9 @@ void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Problem
                                        config.prior_center_sigma_m),
             nullptr, p.params[k].data(), p.center.data());
     }
+    // Gauge freedom: the edges only fix relative poses, so moving every pose by one rigid motion
+    // leaves the cost unchanged. Pose 0 defines the frame (the table frame of pose 0 the fused
+    // cloud lives in) and is held constant; its prior is not added for the same reason.
     if (!graph.poses.empty()) {
         p.problem->AddParameterBlock(p.params[0].data(), 3);
         p.problem->SetParameterBlockConstant(p.params[0].data());
@@ -129,7 +146,7 @@ void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Problem
 
 Status PoseGraphConfig::Validate() const {
     auto bad = [](const std::string& f, const std::string& why) -> Status {
-        return Error{"INVALID_CONFIG", "pose_graph." + f + ": " + why};
+        return Error{ErrorCode::kInvalidConfig, "pose_graph." + f + ": " + why};
     };
     if (!(prior_yaw_sigma_rad > 0.0)) return bad("prior_yaw_sigma_rad", "must be > 0");
     if (!(prior_center_sigma_m > 0.0)) return bad("prior_center_sigma_m", "must be > 0");
@@ -162,11 +179,11 @@ Status SolvePoseGraph(PoseGraph& graph, const PoseGraphConfig& config) {
     options.num_threads = 1;  // deterministic
     options.logging_type = ceres::SILENT;
     std::string why;
-    if (!options.IsValid(&why)) return Error{"INTERNAL", "pose graph solver options: " + why};
+    if (!options.IsValid(&why)) return Error{ErrorCode::kInternal, "pose graph solver options: " + why};
     ceres::Solver::Summary summary;
     ceres::Solve(options, p.problem.get(), &summary);
     if (!summary.IsSolutionUsable()) {
-        return Error{"REGISTRATION_FAILED", "pose graph did not solve: " + summary.message};
+        return Error{ErrorCode::kRegistrationFailed, "pose graph did not solve: " + summary.message};
     }
     for (std::size_t k = 0; k < graph.poses.size(); ++k) {
         graph.poses[k] = Se2{p.params[k][0], p.params[k][1], Se2::WrapAngle(p.params[k][2])};
@@ -177,7 +194,7 @@ Status SolvePoseGraph(PoseGraph& graph, const PoseGraphConfig& config) {
 
 Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfig& config) {
     if (graph.commanded_yaw.size() != graph.poses.size()) {
-        return Error{"INTERNAL", "pose graph: commanded_yaw and poses differ in size"};
+        return Error{ErrorCode::kInternal, "pose graph: commanded_yaw and poses differ in size"};
     }
     PoseGraphReport report;
     for (int round = 0;; ++round) {

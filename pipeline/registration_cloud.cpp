@@ -14,7 +14,7 @@ namespace boxd {
 
 Status RegistrationCloudConfig::Validate(const std::string& where) const {
     auto bad = [&](const std::string& f, const std::string& why) -> Status {
-        return Error{"INVALID_CONFIG", where + "." + f + ": " + why};
+        return Error{ErrorCode::kInvalidConfig, where + "." + f + ": " + why};
     };
     if (!(voxel_m > 0.0005 && voxel_m < 0.1)) return bad("voxel_m", "must be in (0.0005, 0.1)");
     if (outlier_neighbors < 0 || outlier_neighbors > 100) {

@@ -6,10 +6,12 @@
 #include <utility>
 #include <variant>
 
+#include "pipeline/error_code.h"
+
 namespace boxd {
 
 struct Error {
-    std::string code;     // e.g. "INVALID_SESSION", "TURNTABLE_ERROR", "NO_OBJECT"
+    ErrorCode code = ErrorCode::kInternal;
     std::string message;  // one line, names the file/field/device concerned
 };
 

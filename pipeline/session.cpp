@@ -16,4 +16,10 @@ std::string SessionFramePath(std::size_t pose, std::size_t frame) {
     return buf;
 }
 
+std::vector<double> Session::PoseAnglesRad() const {
+    std::vector<double> angles(poses.size());
+    for (std::size_t i = 0; i < poses.size(); ++i) angles[i] = PoseAngleRad(i);
+    return angles;
+}
+
 }  // namespace boxd

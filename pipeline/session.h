@@ -40,6 +40,8 @@ struct Session {
     // Returns the turntable angle of pose `i` in radians, signed so that positive is a
     // counter-clockwise turn about the table axis (cw sessions are negated).
     double PoseAngleRad(std::size_t i) const;
+    // Returns PoseAngleRad of every pose, in pose order.
+    std::vector<double> PoseAnglesRad() const;
 };
 
 // Standard frame path inside a session folder: "pose_003/frame_01.png".

@@ -17,7 +17,7 @@ namespace {
 Error SessionError(const fs::path& file, const std::string& field, const std::string& why) {
     std::string msg = file.string() + ": ";
     if (!field.empty()) msg += field + ": ";
-    return Error{"INVALID_SESSION", msg + why};
+    return Error{ErrorCode::kInvalidSession, msg + why};
 }
 
 // Reads fields of session.json, remembering the file for error messages.
@@ -312,7 +312,7 @@ Result<Session> LoadSession(const fs::path& dir) {
 Status WriteSession(const Session& session, const fs::path& dir) {
     std::error_code ec;
     fs::create_directories(dir, ec);
-    if (ec) return Error{"IO_ERROR", dir.string() + ": cannot create folder: " + ec.message()};
+    if (ec) return Error{ErrorCode::kIoError, dir.string() + ": cannot create folder: " + ec.message()};
 
     json poses = json::array();
     std::vector<std::pair<fs::path, const DepthImage*>> pngs;
@@ -323,7 +323,7 @@ Status WriteSession(const Session& session, const fs::path& dir) {
             const std::string rel =
                 k < p.frame_paths.size() ? p.frame_paths[k] : SessionFramePath(i, k);
             if (!IsContainedRelativePath(rel)) {
-                return Error{"INVALID_INPUT", "frame path '" + rel + "' leaves the session folder"};
+                return Error{ErrorCode::kInvalidInput, "frame path '" + rel + "' leaves the session folder"};
             }
             const fs::path file = dir / rel;
             fs::create_directories(file.parent_path(), ec);
@@ -340,7 +340,7 @@ Status WriteSession(const Session& session, const fs::path& dir) {
             const cv::Mat mat(img->height, img->width, CV_16UC1,
                               const_cast<std::uint16_t*>(img->pixels.data()));
             if (!cv::imwrite(file.string(), mat, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
-                errors[j] = Error{"IO_ERROR", file.string() + ": cannot write PNG"};
+                errors[j] = Error{ErrorCode::kIoError, file.string() + ": cannot write PNG"};
             }
         }
     };
@@ -382,10 +382,10 @@ Status WriteSession(const Session& session, const fs::path& dir) {
     {
         std::ofstream out(tmp);
         out << root.dump(2) << "\n";
-        if (!out) return Error{"IO_ERROR", tmp.string() + ": cannot write"};
+        if (!out) return Error{ErrorCode::kIoError, tmp.string() + ": cannot write"};
     }
     fs::rename(tmp, file, ec);
-    if (ec) return Error{"IO_ERROR", file.string() + ": cannot write: " + ec.message()};
+    if (ec) return Error{ErrorCode::kIoError, file.string() + ": cannot write: " + ec.message()};
     return OkStatus();
 }
 

@@ -6,7 +6,7 @@ namespace boxd {
 
 Status StationCalibration::Validate(const std::string& where) const {
     auto bad = [&](const std::string& field, const std::string& why) -> Status {
-        return Error{"INVALID_INPUT", where + "." + field + ": " + why};
+        return Error{ErrorCode::kInvalidInput, where + "." + field + ": " + why};
     };
     if (!table_center_m.allFinite()) return bad("table_center_m", "must be finite");
     if (!table_axis.allFinite()) return bad("table_axis", "must be finite");

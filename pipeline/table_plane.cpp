@@ -9,7 +9,7 @@ namespace boxd {
 namespace {
 
 Status Bad(const std::string& field, const std::string& why) {
-    return Error{"INVALID_CONFIG", "table_plane." + field + ": " + why};
+    return Error{ErrorCode::kInvalidConfig, "table_plane." + field + ": " + why};
 }
 
 // Robust sigma from the median absolute deviation (1.4826 * MAD for a normal distribution).
@@ -86,7 +86,7 @@ Result<TablePlaneFit> FitTablePlane(const std::vector<DepthMap>& depths,
         }
     }
     if (static_cast<int>(pts.size()) < config.min_points) {
-        return Error{"INSUFFICIENT_DATA", "too few table-top readings to locate the table (" +
+        return Error{ErrorCode::kInsufficientData, "too few table-top readings to locate the table (" +
                                               std::to_string(pts.size()) + ")"};
     }
     // Iteratively trimmed least squares: box faces and bumps near the table top are a minority
@@ -105,7 +105,7 @@ Result<TablePlaneFit> FitTablePlane(const std::vector<DepthMap>& depths,
             if (abs_res[i] <= config.trim_sigmas * sigma) inliers.push_back(pts[i]);
         }
         if (static_cast<int>(inliers.size()) < config.min_points) {
-            return Error{"INSUFFICIENT_DATA", "too few consistent table-top readings"};
+            return Error{ErrorCode::kInsufficientData, "too few consistent table-top readings"};
         }
         plane = FitPlane(inliers, Eigen::Vector3d::UnitZ());
     }
@@ -116,7 +116,7 @@ Result<TablePlaneFit> FitTablePlane(const std::vector<DepthMap>& depths,
     fit.height_correction_m = plane.d;  // signed distance of the recorded origin to the plane
     if (fit.tilt_correction_deg > config.max_tilt_deg ||
         std::abs(fit.height_correction_m) > config.max_shift_m) {
-        return Error{"REGISTRATION_FAILED",
+        return Error{ErrorCode::kRegistrationFailed,
                      "the table top is far from the calibration (tilt " +
                          std::to_string(fit.tilt_correction_deg) + " deg, shift " +
                          std::to_string(fit.height_correction_m) + " m); recalibrate"};

@@ -16,7 +16,7 @@ Status RegistrationConfig::Validate() const {
     if (Status s = coarse.Validate("registration.coarse"); !s) return s;
     if (Status s = fine.Validate("registration.fine"); !s) return s;
     auto bad = [](const std::string& f, const std::string& why) -> Status {
-        return Error{"INVALID_CONFIG", "registration." + f + ": " + why};
+        return Error{ErrorCode::kInvalidConfig, "registration." + f + ": " + why};
     };
     if (max_pose_step < 1) return bad("max_pose_step", "must be >= 1");
     if (!(max_pair_angle_deg > 0.0 && max_pair_angle_deg <= 180.0)) {

@@ -7,7 +7,7 @@ namespace boxd {
 namespace {
 
 Status Bad(const std::string& field, const std::string& why) {
-    return Error{"INVALID_CONFIG", "segmentation." + field + ": " + why};
+    return Error{ErrorCode::kInvalidConfig, "segmentation." + field + ": " + why};
 }
 
 }  // namespace

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/synthetic_station.h"
+#include "drivers/sim/synthetic_station.h"
 #include "tests/support/run_command.h"
 #include "tests/support/temp_dir.h"
 

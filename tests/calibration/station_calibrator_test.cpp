@@ -10,7 +10,7 @@
 #include <cstdio>
 #include <ostream>
 
-#include "pipeline/synthetic_station.h"
+#include "drivers/sim/synthetic_station.h"
 
 namespace boxd {
 namespace {

@@ -40,12 +40,12 @@ public:
         while (hold && !ctx.cancelled()) std::this_thread::sleep_for(2ms);
         in_capture = false;
         if (ctx.cancelled()) {
-            out.result.reason = MeasurementReason{"CANCELLED", "capture cancelled"};
+            out.result.reason = MeasurementReason{ErrorCode::kCancelled, "capture cancelled"};
             return out;
         }
         if (fail_next.exchange(false)) {
             open_ = false;
-            out.result.reason = MeasurementReason{"TURNTABLE_ERROR", "sim: stall"};
+            out.result.reason = MeasurementReason{ErrorCode::kTurntableError, "sim: stall"};
             return out;
         }
         out.result.status = MeasurementStatus::kOk;
@@ -62,8 +62,8 @@ public:
         in_capture = true;
         while (hold && !ctx.cancelled()) std::this_thread::sleep_for(2ms);
         in_capture = false;
-        if (ctx.cancelled()) return Error{"CANCELLED", "capture cancelled"};
-        if (reference.height_m > 1.0) return Error{"WRONG_REFERENCE", "measured 0.2 m high"};
+        if (ctx.cancelled()) return Error{ErrorCode::kCancelled, "capture cancelled"};
+        if (reference.height_m > 1.0) return Error{ErrorCode::kWrongReference, "measured 0.2 m high"};
         return json{{"calibration", {{"depth_scale", 1.0}}}, {"reference_h", reference.height_m}};
     }
     void RequestStop() override { ++stop_requests; }

@@ -164,7 +164,7 @@ TEST(MeasurementStore, UnwritableDataDirIsAnError) {
     std::ofstream(dir / "file") << "x";
     auto store = MeasurementStore::Open(dir / "file" / "data", 10);
     ASSERT_FALSE(store);
-    EXPECT_EQ(store.error().code, kStorageErrorCode);
+    EXPECT_EQ(store.error().code, ErrorCode::kStorageError);
 }
 
 TEST(MeasurementStore, RejectsResultsWithoutAValidId) {

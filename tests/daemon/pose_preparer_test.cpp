@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/synthetic_station.h"
+#include "drivers/sim/synthetic_station.h"
 
 namespace boxd {
 namespace {

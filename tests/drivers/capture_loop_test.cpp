@@ -10,9 +10,9 @@
 #include <thread>
 
 #include "drivers/modbus_client.h"
-#include "drivers/simulated_camera.h"
+#include "drivers/sim/simulated_camera.h"
 #include "drivers/turntable.h"
-#include "drivers/turntable_simulator.h"
+#include "drivers/sim/turntable_simulator.h"
 
 namespace boxd {
 namespace {
@@ -166,7 +166,7 @@ TEST(CaptureLoop, CancellationStopsTheTableMidMove) {
     canceller.join();
 
     ASSERT_FALSE(session.ok());
-    EXPECT_EQ(session.error().code, "CANCELLED");
+    EXPECT_EQ(session.error().code, ErrorCode::kCancelled);
     EXPECT_NE(session.error().message.find("pose 2 of 2"), std::string::npos)
         << session.error().message;
     EXPECT_LT(took, std::chrono::seconds(4));  // did not wait for the 6 s move
@@ -189,7 +189,7 @@ TEST(CaptureLoop, FaultingTurntableGivesTurntableError) {
 
     auto session = CaptureSession(*table, camera, QuickCapture(4), CaptureStation{});
     ASSERT_FALSE(session.ok());
-    EXPECT_EQ(session.error().code, "TURNTABLE_ERROR");
+    EXPECT_EQ(session.error().code, ErrorCode::kTurntableError);
     EXPECT_NE(session.error().message.find("pose"), std::string::npos) << session.error().message;
     auto state = table->State();
     ASSERT_TRUE(state.ok());
@@ -210,7 +210,7 @@ TEST(CaptureLoop, CameraErrorGivesCameraErrorAndStopsTheTable) {
     const int stops_before = sim.ReadRegister(kSimStopCountRegister);
     auto session = CaptureSession(*table, camera, capture, CaptureStation{});
     ASSERT_FALSE(session.ok());
-    EXPECT_EQ(session.error().code, "CAMERA_ERROR");
+    EXPECT_EQ(session.error().code, ErrorCode::kCameraError);
     EXPECT_NE(session.error().message.find("no depth frame within 50 ms"), std::string::npos)
         << session.error().message;
     EXPECT_GT(sim.ReadRegister(kSimStopCountRegister), stops_before);
@@ -222,12 +222,12 @@ TEST(CaptureLoop, CameraThatLostTheTableGivesCameraError) {
     ASSERT_TRUE(table);
     // The camera's angle source fails like a turntable link that went away.
     SimulatedCamera camera(SmallCamera(), [] {
-        return Result<double>(Error{"TURNTABLE_ERROR", "link down"});
+        return Result<double>(Error{ErrorCode::kTurntableError, "link down"});
     });
     ASSERT_TRUE(camera.Open().ok());
     auto session = CaptureSession(*table, camera, QuickCapture(2), CaptureStation{});
     ASSERT_FALSE(session.ok());
-    EXPECT_EQ(session.error().code, "CAMERA_ERROR");
+    EXPECT_EQ(session.error().code, ErrorCode::kCameraError);
     EXPECT_NE(session.error().message.find("link down"), std::string::npos);
 }
 

@@ -5,7 +5,7 @@
 #include <filesystem>
 
 #include "drivers/modbus_turntable.h"
-#include "drivers/turntable_simulator.h"
+#include "drivers/sim/turntable_simulator.h"
 #include "tests/drivers/sim_turntable_process.h"
 
 namespace boxd::test {

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <thread>
 
-#include "drivers/turntable_simulator.h"
+#include "drivers/sim/turntable_simulator.h"
 #include "tests/drivers/sim_turntable_process.h"
 #include "tests/support/run_command.h"
 
@@ -75,7 +75,7 @@ TEST(ModbusTurntable, StallFaultIsATurntableErrorNamingTheFault) {
     auto st = table->MoveTo(90.0);
     ASSERT_FALSE(st.ok());
     EXPECT_LT(SecondsSince(start), 3.0);
-    EXPECT_EQ(st.error().code, "TURNTABLE_ERROR");
+    EXPECT_EQ(st.error().code, ErrorCode::kTurntableError);
     EXPECT_NE(st.error().message.find("stall (code 1)"), std::string::npos) << st.error().message;
     SimRegisters regs(sim.port());
     EXPECT_FALSE(regs.StatusBit(kMovingBit));
@@ -94,7 +94,7 @@ TEST(ModbusTurntable, MoveThatNeverArrivesTimesOutAndIsStopped) {
     auto st = table->MoveTo(90.0);
     const double elapsed = SecondsSince(start);
     ASSERT_FALSE(st.ok());
-    EXPECT_EQ(st.error().code, "TURNTABLE_ERROR");
+    EXPECT_EQ(st.error().code, ErrorCode::kTurntableError);
     EXPECT_NE(st.error().message.find("not finished within 600 ms"), std::string::npos)
         << st.error().message;
     EXPECT_GE(elapsed, 0.6);
@@ -131,7 +131,7 @@ TEST(ModbusTurntable, ExceptionReplyIsAnErrorAndTheTableStaysPut) {
     auto st = table->MoveTo(90.0);
     ASSERT_FALSE(st.ok());
     EXPECT_LT(SecondsSince(start), 3.0);
-    EXPECT_EQ(st.error().code, "TURNTABLE_ERROR");
+    EXPECT_EQ(st.error().code, ErrorCode::kTurntableError);
     EXPECT_NE(st.error().message.find("Modbus exception"), std::string::npos) << st.error().message;
     SimRegisters regs(sim.port());
     EXPECT_NEAR(regs.AngleDeg(), 0.0, 0.01);
@@ -151,7 +151,7 @@ TEST(ModbusTurntable, SlowRepliesAreATimeoutErrorWithinTheRetryBudget) {
     ASSERT_FALSE(st.ok());
     // Move command: 2 attempts of 200 ms, then the stop command: at most 2 more.
     EXPECT_LT(SecondsSince(start), 3.0);
-    EXPECT_EQ(st.error().code, "TURNTABLE_ERROR");
+    EXPECT_EQ(st.error().code, ErrorCode::kTurntableError);
     EXPECT_NE(st.error().message.find("no reply within 200 ms"), std::string::npos)
         << st.error().message;
     EXPECT_NE(st.error().message.find("2 attempts"), std::string::npos) << st.error().message;
@@ -297,7 +297,7 @@ TEST(ModbusTurntable, UnreachableDriveIsAnErrorNotAHang) {
     const auto start = SteadyClock::now();
     auto driver = ModbusTurntable::Open(FastTestConfig(port));
     ASSERT_FALSE(driver.ok());
-    EXPECT_EQ(driver.error().code, "TURNTABLE_ERROR");
+    EXPECT_EQ(driver.error().code, ErrorCode::kTurntableError);
     EXPECT_NE(driver.error().message.find("cannot connect"), std::string::npos);
     EXPECT_LT(SecondsSince(start), 2.0);
 }
@@ -312,7 +312,7 @@ TEST(ModbusTurntable, DriveThatDiesMidSessionGivesAnErrorWithinTheRetryBudget) {
     const auto start = SteadyClock::now();
     auto st = table->MoveTo(20.0);
     ASSERT_FALSE(st.ok());
-    EXPECT_EQ(st.error().code, "TURNTABLE_ERROR");
+    EXPECT_EQ(st.error().code, ErrorCode::kTurntableError);
     EXPECT_NE(st.error().message.find("3 attempts"), std::string::npos) << st.error().message;
     EXPECT_LT(SecondsSince(start), 3.0);
 }

@@ -42,11 +42,11 @@ TEST(OpenNi2Camera, MissingRecordingIsACameraErrorNamingIt) {
     OpenNi2Camera camera(c, std::nullopt, 0.001);
     const Status st = camera.Open();
     ASSERT_FALSE(st.ok());
-    EXPECT_EQ(st.error().code, "CAMERA_ERROR");
+    EXPECT_EQ(st.error().code, ErrorCode::kCameraError);
     EXPECT_NE(st.error().message.find("/nonexistent/boxd/recording.oni"), std::string::npos);
     const auto frame = camera.Grab(milliseconds(10));
     ASSERT_FALSE(frame.ok());
-    EXPECT_EQ(frame.error().code, "CAMERA_ERROR");
+    EXPECT_EQ(frame.error().code, ErrorCode::kCameraError);
 }
 
 TEST(OpenNi2Camera, MissingUsbDeviceIsACameraError) {
@@ -55,7 +55,7 @@ TEST(OpenNi2Camera, MissingUsbDeviceIsACameraError) {
     OpenNi2Camera camera(c, std::nullopt, 0.001);
     const Status st = camera.Open();
     ASSERT_FALSE(st.ok());
-    EXPECT_EQ(st.error().code, "CAMERA_ERROR");
+    EXPECT_EQ(st.error().code, ErrorCode::kCameraError);
     EXPECT_NE(st.error().message.find("cannot open device"), std::string::npos);
 }
 
@@ -92,7 +92,7 @@ TEST(OpenNi2Camera, StreamWithoutFieldOfViewNeedsConfiguredIntrinsics) {
     OpenNi2Camera camera(DummyConfig(), std::nullopt, 0.001);
     const Status st = camera.Open();
     ASSERT_FALSE(st.ok());
-    EXPECT_EQ(st.error().code, "CAMERA_ERROR");
+    EXPECT_EQ(st.error().code, ErrorCode::kCameraError);
     EXPECT_NE(st.error().message.find("camera.intrinsics"), std::string::npos);
 }
 
@@ -146,7 +146,7 @@ TEST(OpenNi2Camera, RecordingOfTheDummyDeviceReadsBack) {
         EXPECT_EQ(frame->width, 320);
         EXPECT_EQ(frame->at(5, 0), 2000);
     } else {
-        EXPECT_EQ(frame.error().code, "CAMERA_ERROR");
+        EXPECT_EQ(frame.error().code, ErrorCode::kCameraError);
     }
     camera.Close();
 }
@@ -173,7 +173,7 @@ TEST(UsbDevices, OpenNiUriCarriesTheUsbAddress) {
 TEST(UsbDevices, ResettingAMissingDeviceIsACameraError) {
     const Status st = ResetUsbDevice(UsbAddress{250, 127});
     ASSERT_FALSE(st.ok());
-    EXPECT_EQ(st.error().code, "CAMERA_ERROR");
+    EXPECT_EQ(st.error().code, ErrorCode::kCameraError);
 }
 
 }  // namespace

@@ -15,7 +15,7 @@
 
 #include "drivers/station_config.h"
 #include "pipeline/session_io.h"
-#include "pipeline/synthetic_station.h"
+#include "drivers/sim/synthetic_station.h"
 #include "tests/support/child_process.h"
 #include "tests/support/run_command.h"
 #include "tests/support/temp_dir.h"

@@ -11,7 +11,7 @@
 #include "drivers/replay_turntable.h"
 #include "drivers/station_config.h"
 #include "pipeline/session_io.h"
-#include "pipeline/synthetic_station.h"
+#include "drivers/sim/synthetic_station.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd {
@@ -71,7 +71,7 @@ TEST(ReplayDrivers, AngleWithoutARecordedPoseIsATurntableError) {
     ReplayTurntable table(*source);
     const Status st = table.MoveTo(45.0);
     ASSERT_FALSE(st.ok());
-    EXPECT_EQ(st.error().code, "TURNTABLE_ERROR");
+    EXPECT_EQ(st.error().code, ErrorCode::kTurntableError);
     EXPECT_NE(st.error().message.find("no pose at 45"), std::string::npos) << st.error().message;
     EXPECT_NE(st.error().message.find("0, 90, 180, 270"), std::string::npos);
 }
@@ -81,7 +81,7 @@ TEST(ReplayDrivers, InvalidSessionIsRefused) {
     std::ofstream(dir / "session.json") << R"({"format": "boxd.session/2"})";
     auto source = ReplaySource::Load(dir.path());
     ASSERT_FALSE(source.ok());
-    EXPECT_EQ(source.error().code, "INVALID_SESSION");
+    EXPECT_EQ(source.error().code, ErrorCode::kInvalidSession);
 }
 
 TEST(ReplayDrivers, ReplayStationCapturesTheRecordedSession) {

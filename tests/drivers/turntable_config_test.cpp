@@ -82,7 +82,7 @@ class TurntableConfigErrors : public ::testing::TestWithParam<BadConfigCase> {};
 TEST_P(TurntableConfigErrors, NameTheField) {
     auto c = ParseTurntableConfig(YAML::Load(GetParam().yaml));
     ASSERT_FALSE(c.ok()) << GetParam().yaml;
-    EXPECT_EQ(c.error().code, "INVALID_INPUT");
+    EXPECT_EQ(c.error().code, ErrorCode::kInvalidInput);
     EXPECT_NE(c.error().message.find(GetParam().field), std::string::npos) << c.error().message;
 }
 

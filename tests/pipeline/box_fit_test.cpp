@@ -74,7 +74,7 @@ TEST(FitFootprintBox, RefusesTinyObject) {
     const Points pts = SampleBox(0.02, 0.02, 0.02, 0.0, {0.0, 0.0}, 0.0, 4, 0.002);
     auto fit = FitFootprintBox(pts, BoxFitConfig{});
     ASSERT_FALSE(fit.ok());
-    EXPECT_EQ(fit.error().code, "OBJECT_TOO_SMALL");
+    EXPECT_EQ(fit.error().code, ErrorCode::kObjectTooSmall);
 }
 
 TEST(FitFootprintBox, RefusesWhenASideIsUnseen) {
@@ -83,7 +83,7 @@ TEST(FitFootprintBox, RefusesWhenASideIsUnseen) {
     std::erase_if(pts, [](const Eigen::Vector3f& p) { return p.x() < -0.145f && p.z() < 0.149f; });
     auto fit = FitFootprintBox(pts, BoxFitConfig{});
     ASSERT_FALSE(fit.ok());
-    EXPECT_EQ(fit.error().code, "INSUFFICIENT_DATA");
+    EXPECT_EQ(fit.error().code, ErrorCode::kInsufficientData);
 }
 
 TEST(FitPcaBox, AxisAlignedBox) {

@@ -4,7 +4,11 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/synthetic_station.h"
+#include <cmath>
+#include <set>
+#include <string>
+
+#include "drivers/sim/synthetic_station.h"
 
 namespace boxd {
 namespace {
@@ -61,8 +65,36 @@ TEST(MeasurePrepared, RefusesPosesItCannotUse) {
     ASSERT_TRUE(r.ok());
     EXPECT_EQ(r->result.status, MeasurementStatus::kNoDim);
     ASSERT_TRUE(r->result.reason.has_value());
-    EXPECT_EQ(r->result.reason->code, "INSUFFICIENT_DATA");
+    EXPECT_EQ(r->result.reason->code, ErrorCode::kInsufficientData);
     EXPECT_NE(r->result.reason->message.find("pose 3"), std::string::npos);
+}
+
+TEST(MeasureSession, ReportsOnlyItsStageLapsOnTheCallersClock) {
+    const Session session = SmallSession();
+    // A clock that advances 1 ms per reading: every lap is a whole number of readings.
+    double t = 0.0;
+    const MonotonicMs clock = [&t] { return t += 1.0; };
+    auto out = MeasureSession(session, MeasureConfig{}, BoxMethod::kFootprint, clock);
+    ASSERT_TRUE(out.ok());
+    ASSERT_EQ(out->result.status, MeasurementStatus::kOk);
+    std::set<std::string> stages;
+    for (const auto& [name, ms] : out->result.timing_ms) {
+        stages.insert(name);
+        EXPECT_GT(ms, 0.0) << name;
+        EXPECT_EQ(ms, std::round(ms)) << name;
+    }
+    EXPECT_EQ(stages, (std::set<std::string>{"fit", "fusion", "optimization", "preprocess",
+                                             "registration"}));
+    // Ids, timestamps, the capture and the total are the caller's.
+    EXPECT_TRUE(out->result.id.empty());
+    EXPECT_TRUE(out->result.started_at.empty());
+    EXPECT_TRUE(out->result.finished_at.empty());
+
+    // Without a clock the laps are there and zero, and the numbers the same.
+    auto unclocked = MeasureSession(session, MeasureConfig{}, BoxMethod::kFootprint);
+    ASSERT_TRUE(unclocked.ok());
+    for (const auto& [name, ms] : unclocked->result.timing_ms) EXPECT_EQ(ms, 0.0) << name;
+    EXPECT_EQ(unclocked->result.dimensions->length_m, out->result.dimensions->length_m);
 }
 
 }  // namespace

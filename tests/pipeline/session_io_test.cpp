@@ -83,7 +83,7 @@ std::string LoadError(const std::function<void(json&, const fs::path&)>& mutate)
     auto loaded = LoadSession(dir.path());
     EXPECT_FALSE(loaded.ok());
     if (loaded.ok()) return "";
-    EXPECT_EQ(loaded.error().code, "INVALID_SESSION");
+    EXPECT_EQ(loaded.error().code, ErrorCode::kInvalidSession);
     EXPECT_EQ(loaded.error().message.find('\n'), std::string::npos);
     return loaded.error().message;
 }

@@ -117,17 +117,9 @@ int ChildProcess::Terminate(std::chrono::milliseconds grace) {
 
 SimTurntableProcess::SimTurntableProcess(const std::vector<std::string>& extra_args,
                                          const std::filesystem::path& log) {
-    std::vector<std::string> argv{BOXD_BINARY, "sim-turntable", "--port",
-                                  "0",         "--port-file",   (dir_ / "port").string()};
-    argv.insert(argv.end(), extra_args.begin(), extra_args.end());
-    process_ = std::make_unique<ChildProcess>(argv, log);
-    const auto deadline = Clock::now() + std::chrono::seconds(10);
-    while (Clock::now() < deadline && process_->Running()) {
-        std::ifstream in(dir_ / "port");
-        if (in >> port_) break;
-        port_ = 0;
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    auto started = boxd::SimTurntableProcess::Start({BOXD_BINARY, 0, extra_args, log});
+    EXPECT_TRUE(started.ok()) << started.error().message;
+    if (started) process_ = std::move(*started);
 }
 
 }  // namespace boxd::test

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "drivers/sim/sim_turntable_process.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd::test {
@@ -50,22 +51,20 @@ private:
     int exit_code_ = -1;
 };
 
-// `boxd sim-turntable` on a free loopback port (the simulator picks it and writes it to a file,
-// so there is no race for the port), with `extra_args` appended; its stderr is appended to `log`
-// when one is given.
+// `boxd sim-turntable` on a free loopback port, started the one way boxd starts it
+// (SimTurntableProcess), with `extra_args` appended; its stderr is appended to `log` when one is
+// given.
 class SimTurntableProcess {
 public:
     explicit SimTurntableProcess(const std::vector<std::string>& extra_args,
                                  const std::filesystem::path& log = {});
 
     // Returns the TCP port, or 0 if the simulator did not start.
-    int port() const { return port_; }
-    ChildProcess& process() { return *process_; }
+    int port() const { return process_ ? process_->port() : 0; }
+    boxd::SimTurntableProcess& process() { return *process_; }
 
 private:
-    TempDir dir_;
-    std::unique_ptr<ChildProcess> process_;
-    int port_ = 0;
+    std::unique_ptr<boxd::SimTurntableProcess> process_;
 };
 
 }  // namespace boxd::test

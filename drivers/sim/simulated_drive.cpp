@@ -1,4 +1,4 @@
-#include "drivers/simulated_drive.h"
+#include "drivers/sim/simulated_drive.h"
 
 #include <algorithm>
 #include <cmath>

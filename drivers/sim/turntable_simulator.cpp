@@ -1,4 +1,4 @@
-#include "drivers/turntable_simulator.h"
+#include "drivers/sim/turntable_simulator.h"
 
 #include <arpa/inet.h>
 #include <modbus/modbus.h>
@@ -16,7 +16,8 @@
 #include <utility>
 #include <vector>
 
-#include "drivers/simulated_drive.h"
+#include "drivers/sim/modbus_request.h"
+#include "drivers/sim/simulated_drive.h"
 #include "drivers/turntable_profile.h"
 
 namespace boxd {
@@ -29,112 +30,9 @@ constexpr int kRegisterCount = 110;
 constexpr int kFirstSpecialRegister = 100;
 constexpr int kPollSliceMs = 10;
 
-struct FaultName {
-    SimulatedFault fault;
-    const char* name;
-};
-constexpr FaultName kFaultNames[] = {
-    {SimulatedFault::kNone, "none"},           {SimulatedFault::kStall, "stall"},
-    {SimulatedFault::kTimeout, "timeout"},     {SimulatedFault::kDrop, "drop"},
-    {SimulatedFault::kException, "exception"}, {SimulatedFault::kSlow, "slow"}};
-
-Error SimError(const std::string& message) { return Error{"INVALID_INPUT", message}; }
-
-// One register write found in a request: the registers it sets.
-struct RegisterWrite {
-    int address = 0;
-    std::vector<uint16_t> values;
-};
-
-// Decodes the register writes and the register range a request touches (functions 3, 6, 16 and
-// 23 of the Modbus Application Protocol v1.1b3, section 6). `header` is the ADU header length.
-struct DecodedRequest {
-    int function = 0;
-    int lowest_register = 0;  // lowest register read or written (0 when unknown)
-    std::vector<RegisterWrite> writes;
-};
-
-uint16_t Word(const uint8_t* p) { return static_cast<uint16_t>((p[0] << 8) | p[1]); }
-
-DecodedRequest Decode(const uint8_t* req, int length, int header) {
-    DecodedRequest d;
-    if (length < header + 5) return d;
-    const uint8_t* pdu = req + header;
-    d.function = pdu[0];
-    const int address = Word(pdu + 1);
-    d.lowest_register = address;
-    if (d.function == MODBUS_FC_WRITE_SINGLE_REGISTER) {
-        d.writes.push_back({address, {Word(pdu + 3)}});
-    } else if (d.function == MODBUS_FC_WRITE_MULTIPLE_REGISTERS && length >= header + 6) {
-        const int count = Word(pdu + 3);
-        if (length >= header + 6 + 2 * count) {
-            RegisterWrite w{address, {}};
-            for (int i = 0; i < count; ++i) w.values.push_back(Word(pdu + 6 + 2 * i));
-            d.writes.push_back(std::move(w));
-        }
-    } else if (d.function == MODBUS_FC_WRITE_AND_READ_REGISTERS && length >= header + 10) {
-        const int write_address = Word(pdu + 5);
-        const int count = Word(pdu + 7);
-        if (length >= header + 10 + 2 * count) {
-            RegisterWrite w{write_address, {}};
-            for (int i = 0; i < count; ++i) w.values.push_back(Word(pdu + 10 + 2 * i));
-            d.writes.push_back(std::move(w));
-            d.lowest_register = std::min(address, write_address);
-        }
-    }
-    return d;
-}
-
-bool Touches(const RegisterWrite& w, int lo, int hi) {
-    const int last = w.address + static_cast<int>(w.values.size()) - 1;
-    return w.address <= hi && last >= lo;
-}
-
-// Returns the value `w` writes to `address`, or -1.
-int ValueAt(const RegisterWrite& w, int address) {
-    const int i = address - w.address;
-    if (i < 0 || i >= static_cast<int>(w.values.size())) return -1;
-    return w.values[static_cast<std::size_t>(i)];
-}
+Error SimError(const std::string& message) { return Error{ErrorCode::kInvalidInput, message}; }
 
 }  // namespace
-
-Result<SimulatedFault> ParseSimulatedFault(const std::string& name) {
-    for (const auto& f : kFaultNames) {
-        if (name == f.name) return f.fault;
-    }
-    return SimError(
-        "sim-turntable.fault: must be none, stall, timeout, drop, exception or slow, "
-        "got '" +
-        name + "'");
-}
-
-const char* SimulatedFaultName(SimulatedFault fault) {
-    for (const auto& f : kFaultNames) {
-        if (fault == f.fault) return f.name;
-    }
-    return "unknown";
-}
-
-Status TurntableSimulatorConfig::Validate() const {
-    if (!(max_speed_dps > 0.0) || max_speed_dps > 6553.5) {
-        return SimError("sim-turntable.max_speed_dps: must be in (0, 6553.5] °/s");
-    }
-    if (settle_ms < 0 || settle_ms > 65535) {
-        return SimError("sim-turntable.settle_ms: must be 0..65535");
-    }
-    if (!std::isfinite(initial_angle_deg) || std::abs(initial_angle_deg) > 1e6) {
-        return SimError("sim-turntable.initial_angle_deg: must be a finite angle");
-    }
-    if (fault_after_moves < 0 || fault_after_moves > 65535) {
-        return SimError("sim-turntable.fault_after_moves: must be 0..65535");
-    }
-    if (slow_reply_ms < 0 || slow_reply_ms > 65535) {
-        return SimError("sim-turntable.slow_reply_ms: must be 0..65535");
-    }
-    if (slave_id < 1 || slave_id > 247) return SimError("sim-turntable.slave_id: must be 1..247");
-    return OkStatus();
-}
 
 struct TurntableSimulator::Impl {
     explicit Impl(const TurntableSimulatorConfig& c) : config(c), drive(c.initial_angle_deg) {}
@@ -289,7 +187,7 @@ struct TurntableSimulator::Impl {
     // is to be closed (an injected drop).
     bool Handle(const uint8_t* req, int length) {
         Publish();
-        const DecodedRequest d = Decode(req, length, modbus_get_header_length(ctx));
+        const DecodedRequest d = DecodeModbusRequest(req, length, modbus_get_header_length(ctx));
         const bool drive_register = d.lowest_register < kFirstSpecialRegister;
         if (drive_register && FaultActive(SimulatedFault::kDrop) && !dropped_this_move &&
             d.writes.empty()) {
@@ -341,7 +239,7 @@ struct TurntableSimulator::Impl {
         const int n = select(max_fd + 1, &readable, nullptr, nullptr, &timeout);
         if (n < 0) {
             if (errno == EINTR) return OkStatus();
-            return Error{"INTERNAL", std::string("sim-turntable: select: ") + strerror(errno)};
+            return Error{ErrorCode::kInternal, std::string("sim-turntable: select: ") + strerror(errno)};
         }
         Publish();
         if (n == 0) return OkStatus();
@@ -386,7 +284,7 @@ struct TurntableSimulator::Impl {
         const int n = select(fd + 1, &readable, nullptr, nullptr, &timeout);
         if (n < 0) {
             if (errno == EINTR) return OkStatus();
-            return Error{"INTERNAL", std::string("sim-turntable: select: ") + strerror(errno)};
+            return Error{ErrorCode::kInternal, std::string("sim-turntable: select: ") + strerror(errno)};
         }
         Publish();
         if (n == 0) return OkStatus();
@@ -421,14 +319,14 @@ TurntableSimulator::~TurntableSimulator() {
 
 Status TurntableSimulator::ListenTcp(const std::string& host, int port) {
     if (auto st = impl_->config.Validate(); !st) return st;
-    if (!impl_->map) return Error{"INTERNAL", "sim-turntable: cannot allocate the registers"};
+    if (!impl_->map) return Error{ErrorCode::kInternal, "sim-turntable: cannot allocate the registers"};
     impl_->ctx = modbus_new_tcp(host.c_str(), port);
     if (!impl_->ctx) {
         return SimError("sim-turntable: bad listen address " + host + ":" + std::to_string(port));
     }
     impl_->listen_fd = modbus_tcp_listen(impl_->ctx, 8);
     if (impl_->listen_fd < 0) {
-        return Error{"INTERNAL", "sim-turntable: cannot listen on " + host + ":" +
+        return Error{ErrorCode::kInternal, "sim-turntable: cannot listen on " + host + ":" +
                                      std::to_string(port) + ": " + modbus_strerror(errno)};
     }
     sockaddr_in bound{};
@@ -444,7 +342,7 @@ int TurntableSimulator::port() const { return impl_->port; }
 Status TurntableSimulator::OpenRtu(const std::string& device, int baud, char parity, int data_bits,
                                    int stop_bits) {
     if (auto st = impl_->config.Validate(); !st) return st;
-    if (!impl_->map) return Error{"INTERNAL", "sim-turntable: cannot allocate the registers"};
+    if (!impl_->map) return Error{ErrorCode::kInternal, "sim-turntable: cannot allocate the registers"};
     impl_->rtu = true;
     impl_->ctx = modbus_new_rtu(device.c_str(), baud, parity, data_bits, stop_bits);
     if (!impl_->ctx) {
@@ -453,7 +351,7 @@ Status TurntableSimulator::OpenRtu(const std::string& device, int baud, char par
     }
     modbus_set_slave(impl_->ctx, impl_->config.slave_id);
     if (modbus_connect(impl_->ctx) == -1) {
-        return Error{"INTERNAL",
+        return Error{ErrorCode::kInternal,
                      "sim-turntable: cannot open " + device + ": " + modbus_strerror(errno)};
     }
     spdlog::info("sim-turntable: serving Modbus RTU on {} ({} baud, slave {})", device, baud,
@@ -462,7 +360,7 @@ Status TurntableSimulator::OpenRtu(const std::string& device, int baud, char par
 }
 
 Status TurntableSimulator::Serve(const std::atomic<bool>& stop) {
-    if (!impl_->ctx) return Error{"INTERNAL", "sim-turntable: not listening"};
+    if (!impl_->ctx) return Error{ErrorCode::kInternal, "sim-turntable: not listening"};
     while (!stop.load()) {
         auto st = impl_->rtu ? impl_->ServeRtuOnce() : impl_->ServeTcpOnce();
         if (!st) return st;

@@ -1,4 +1,4 @@
-#include "pipeline/synthetic_station.h"
+#include "drivers/sim/synthetic_station.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -9,8 +9,8 @@
 #include <thread>
 #include <vector>
 
-#include "pipeline/synthetic_geometry.h"
-#include "pipeline/synthetic_random.h"
+#include "drivers/sim/synthetic_geometry.h"
+#include "drivers/sim/synthetic_random.h"
 
 namespace boxd {
 
@@ -37,7 +37,7 @@ enum FrameStream : std::uint64_t {
 };
 
 Error Bad(const std::string& field, const std::string& why) {
-    return {"INVALID_INPUT", field + ": " + why};
+    return {ErrorCode::kInvalidInput, field + ": " + why};
 }
 
 bool Finite(double x) { return std::isfinite(x); }

@@ -1,4 +1,4 @@
-#include "pipeline/synthetic_geometry.h"
+#include "drivers/sim/synthetic_geometry.h"
 
 #include <cmath>
 #include <limits>

@@ -1,4 +1,4 @@
-#include "pipeline/synthetic_random.h"
+#include "drivers/sim/synthetic_random.h"
 
 #include <cmath>
 

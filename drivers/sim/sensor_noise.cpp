@@ -1,4 +1,4 @@
-#include "pipeline/sensor_noise.h"
+#include "drivers/sim/sensor_noise.h"
 
 #include <cmath>
 
@@ -20,13 +20,13 @@ Result<NoiseModel> ParseNoiseModel(const std::string& name) {
     if (name == "none") return NoiseModel::kNone;
     if (name == "kinect") return NoiseModel::kKinect;
     if (name == "realsense") return NoiseModel::kRealSense;
-    return Error{"INVALID_INPUT",
+    return Error{ErrorCode::kInvalidInput,
                  "noise: unknown noise model '" + name + "' (expected kinect, realsense or none)"};
 }
 
 Status SensorNoiseParams::Validate(const std::string& where) const {
     auto bad = [&](const std::string& field, const std::string& why) -> Status {
-        return Error{"INVALID_INPUT", where + "." + field + ": " + why};
+        return Error{ErrorCode::kInvalidInput, where + "." + field + ": " + why};
     };
     auto in = [](double x, double lo, double hi) { return std::isfinite(x) && x >= lo && x <= hi; };
     if (!in(lateral_sigma_px, 0.0, 10.0)) return bad("lateral_sigma_px", "must be in 0..10");

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "drivers/depth_camera.h"
-#include "pipeline/synthetic_station.h"
+#include "drivers/sim/synthetic_station.h"
 
 namespace boxd {
 

@@ -1,5 +1,5 @@
 // The simulated depth camera.
-#include "drivers/simulated_camera.h"
+#include "drivers/sim/simulated_camera.h"
 
 #include <cmath>
 #include <random>
@@ -25,15 +25,15 @@ constexpr double kSamePoseDeg = 0.05;
 
 Status SimulatedCameraConfig::Validate() const {
     if (frame_interval_ms < 0 || frame_interval_ms > 10'000) {
-        return Error{"INVALID_INPUT", "camera.simulated.frame_interval_ms: must be 0..10000"};
+        return Error{ErrorCode::kInvalidInput, "camera.simulated.frame_interval_ms: must be 0..10000"};
     }
     if (auto st = station.Validate(); !st) {
         std::string message = st.error().message;
         // The station's own messages name the field; put them under the YAML section.
         if (message.rfind("camera", 0) == 0 && message.rfind("camera.", 0) != 0) {
-            return Error{"INVALID_INPUT", "camera." + message};
+            return Error{ErrorCode::kInvalidInput, "camera." + message};
         }
-        return Error{"INVALID_INPUT", "camera.simulated." + message};
+        return Error{ErrorCode::kInvalidInput, "camera.simulated." + message};
     }
     return OkStatus();
 }

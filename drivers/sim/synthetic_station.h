@@ -7,7 +7,7 @@
 #include <optional>
 
 #include "pipeline/result.h"
-#include "pipeline/sensor_noise.h"
+#include "drivers/sim/sensor_noise.h"
 #include "pipeline/session.h"
 
 namespace boxd {

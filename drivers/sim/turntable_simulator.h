@@ -2,8 +2,8 @@
 // TurntableSimulator: a Modbus server (libmodbus, TCP or RTU) that behaves like the turntable
 // drive of SPEC section 8 — the angle advances in real time at the commanded speed, a move
 // ends with a settle time before "in position", and faults can be injected so a client's error
-// paths can be exercised for real. `boxd sim-turntable` runs it; tests and the "simulated"
-// turntable driver run it in-process on a thread.
+// paths can be exercised for real. `boxd sim-turntable` runs it (SimTurntableProcess launches
+// that as a child process); unit tests run it on a thread of their own.
 //
 // Special holding registers (beyond the drive's map; never subject to injected faults), in the
 // manner of libmodbus's own unit-test server:

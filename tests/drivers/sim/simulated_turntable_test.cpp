@@ -1,13 +1,13 @@
-// The simulator's motion model on a synthetic clock, and the in-process "simulated" turntable
+// The simulator's motion model on a synthetic clock, and the "simulated" turntable driver
 // driver (TurntableSimulator on a thread, driven over Modbus TCP on loopback).
 #include <gtest/gtest.h>
 
 #include <atomic>
 #include <thread>
 
-#include "drivers/simulated_drive.h"
+#include "drivers/sim/simulated_drive.h"
 #include "drivers/turntable.h"
-#include "drivers/turntable_simulator.h"
+#include "drivers/sim/turntable_simulator.h"
 #include "tests/drivers/sim_turntable_process.h"
 
 namespace boxd {
@@ -81,6 +81,7 @@ TEST(SimulatedDrive, NeverArrivingMoveKeepsMovingUntilStopped) {
 TEST(SimulatedTurntableDriver, MovesOverLoopbackModbus) {
     TurntableConfig config = test::FastTestConfig(0);
     config.driver = "simulated";
+    config.simulator_binary = BOXD_BINARY;  // this process is the test, not boxd
     auto table = MakeTurntable(config);
     ASSERT_TRUE(table.ok()) << table.error().message;
     EXPECT_NE((*table)->Describe().find("simulated, modbus-tcp 127.0.0.1:"), std::string::npos)

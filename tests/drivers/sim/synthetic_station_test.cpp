@@ -1,6 +1,6 @@
 // Known-answer tests of the synthetic station: exact geometry, the injected calibration errors,
 // the noise statistics against their published formulas, and determinism.
-#include "pipeline/synthetic_station.h"
+#include "drivers/sim/synthetic_station.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <set>
 #include <vector>
 
-#include "pipeline/synthetic_geometry.h"
+#include "drivers/sim/synthetic_geometry.h"
 
 namespace boxd {
 namespace {

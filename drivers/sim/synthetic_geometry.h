@@ -4,7 +4,7 @@
 
 #include <Eigen/Core>
 
-#include "pipeline/synthetic_station.h"
+#include "drivers/sim/synthetic_station.h"
 
 namespace boxd {
 

@@ -1,0 +1,20 @@
+#include "pipeline/fuse_and_fit.h"
+
+namespace boxd {
+
+FusedFit FuseAndFit(const std::vector<Points>& view_points, const std::vector<Se2>& poses,
+                    const FusionConfig& fusion, const BoxFitConfig& box_fit, StageLaps* laps) {
+    FusedFit out;
+    out.fused = FuseViews(view_points, poses, fusion);
+    if (laps) laps->Lap("fusion");
+    out.box = FitFootprintBox(out.fused.points, box_fit);
+    out.pca = FitPcaBox(out.fused.points);
+    if (laps) laps->Lap("fit");
+    if (out.box) {
+        out.consistency = CheckViewConsistency(out.fused, static_cast<int>(view_points.size()),
+                                               *out.box, fusion);
+    }
+    return out;
+}
+
+}  // namespace boxd

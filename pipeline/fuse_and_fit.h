@@ -1,0 +1,27 @@
+#pragma once
+// Stages 5 and 6: fusion of the registered views into one table-frame cloud (FuseViews), the
+// box fits (FitFootprintBox, FitPcaBox) and the per-view consistency with the fitted box
+// (CheckViewConsistency). Measurement and calibration share it.
+
+#include <vector>
+
+#include "pipeline/box_fit.h"
+#include "pipeline/fusion.h"
+#include "pipeline/result.h"
+#include "pipeline/stage_laps.h"
+
+namespace boxd {
+
+struct FusedFit {
+    FusedCloud fused;                  // table frame of pose 0
+    Result<BoxFit> box = BoxFit{};     // the footprint box, or why the cloud supports none
+    OrientedBox pca;                   // the PCA box of the same cloud
+    ConsistencyReport consistency;     // per view, against `box` (empty when there is none)
+};
+
+// Returns the fusion of `view_points` (per view, its own frame) moved by `poses`, and the fits.
+// Laps "fusion" and "fit" on `laps` when given.
+FusedFit FuseAndFit(const std::vector<Points>& view_points, const std::vector<Se2>& poses,
+                    const FusionConfig& fusion, const BoxFitConfig& box_fit, StageLaps* laps);
+
+}  // namespace boxd

@@ -1,0 +1,51 @@
+#pragma once
+// MeasureConfig: the measurement's settings, one struct per stage in recipe order (the YAML
+// sections carry the same names), plus the refusal rules and the confidence figure.
+
+#include "pipeline/box_fit.h"
+#include "pipeline/frame_averaging.h"
+#include "pipeline/fusion.h"
+#include "pipeline/pose_graph.h"
+#include "pipeline/refusal.h"
+#include "pipeline/result.h"
+#include "pipeline/table_plane.h"
+#include "pipeline/view_registration.h"
+#include "pipeline/view_segmentation.h"
+
+namespace boxd {
+
+// quality.confidence: the share of alignments kept, discounted by registration RMSE, face
+// noise and a thin cloud. A heuristic in [0, 1] for operators, not a probability.
+struct ConfidenceConfig {
+    double rmse_scale_m = 0.004;        // exp(-registration RMSE / this)
+    double face_sigma_scale_m = 0.01;   // exp(-face sigma / this)
+    long full_points = 20000;           // fewer fused points scale it down linearly
+    double single_view_share = 0.5;     // the "kept share" of a one-pose session
+
+    // Returns an error naming the first invalid field, or Ok.
+    Status Validate() const;
+};
+
+struct MeasureConfig {
+    AveragingConfig averaging;
+    FlyingPixelConfig flying_pixels;
+    TablePlaneConfig table_plane;
+    SegmentationConfig segmentation;
+    RegistrationConfig registration;
+    PoseGraphConfig pose_graph;
+    FusionConfig fusion;
+    BoxFitConfig box_fit;
+    RefusalConfig refusal;
+    ConfidenceConfig confidence;
+    int threads = 2;  // for the per-pose stages; registration has its own
+
+    // Returns an error naming the first invalid field, or Ok.
+    Status Validate() const;
+};
+
+enum class BoxMethod { kFootprint, kPca };
+
+// Returns "footprint" / "pca".
+const char* BoxMethodName(BoxMethod m);
+
+}  // namespace boxd

@@ -1,0 +1,29 @@
+#include "pipeline/object_views.h"
+
+#include "pipeline/parallel_for.h"
+
+namespace boxd {
+
+ObjectViews SegmentObjectViews(const std::vector<DepthMap>& depths, const CameraIntrinsics& camera,
+                               const StationCalibration& calibration,
+                               const Eigen::Isometry3d& camera_to_table,
+                               const SegmentationConfig& segmentation,
+                               const RegistrationCloudConfig& coarse_cloud,
+                               const RegistrationCloudConfig& fine_cloud, int threads) {
+    const int n = static_cast<int>(depths.size());
+    ObjectViews out;
+    out.views.resize(depths.size());
+    out.clouds.resize(depths.size());
+    ParallelFor(n, threads, [&](int k) {
+        const auto i = static_cast<std::size_t>(k);
+        out.views[i] = SegmentView(depths[i], camera, calibration, camera_to_table, segmentation);
+        out.clouds[i] = BuildRegistrationClouds(out.views[i].points, coarse_cloud, fine_cloud);
+        out.views[i].points = Points{};
+    });
+    for (const SegmentedView& v : out.views) {
+        out.fusion_points += static_cast<long>(v.fusion_points.size());
+    }
+    return out;
+}
+
+}  // namespace boxd

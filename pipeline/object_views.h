@@ -1,0 +1,29 @@
+#pragma once
+// Stage 3: every view's object points (SegmentView) and registration clouds
+// (BuildRegistrationClouds), in the refitted table frame, with the counts the refusal rules
+// judge. Measurement and calibration share it.
+
+#include <vector>
+
+#include "pipeline/registration_cloud.h"
+#include "pipeline/view_segmentation.h"
+
+namespace boxd {
+
+struct ObjectViews {
+    // Per view: the fusion subset of its object points, and its counts. The full-density
+    // `points` are dropped once the registration clouds are built (nothing later needs them).
+    std::vector<SegmentedView> views;
+    std::vector<RegistrationClouds> clouds;  // per view: coarse and fine
+    long fusion_points = 0;                  // over all views
+};
+
+// Returns the object views of the averaged `depths` (one per pose) on `threads` threads.
+ObjectViews SegmentObjectViews(const std::vector<DepthMap>& depths, const CameraIntrinsics& camera,
+                               const StationCalibration& calibration,
+                               const Eigen::Isometry3d& camera_to_table,
+                               const SegmentationConfig& segmentation,
+                               const RegistrationCloudConfig& coarse_cloud,
+                               const RegistrationCloudConfig& fine_cloud, int threads);
+
+}  // namespace boxd

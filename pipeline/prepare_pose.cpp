@@ -1,0 +1,50 @@
+#include "pipeline/prepare_pose.h"
+
+#include <spdlog/fmt/fmt.h>
+
+#include "pipeline/parallel_for.h"
+
+namespace boxd {
+
+PreparedPose PreparePose(const std::vector<DepthImage>& frames, double depth_unit_m,
+                         const MeasureConfig& config) {
+    PreparedPose out;
+    auto avg = AverageDepthFrames(frames, depth_unit_m, config.averaging);
+    if (!avg) {
+        out.error = avg.error().message;
+        return out;
+    }
+    out.depth = RemoveFlyingPixels(*avg, config.flying_pixels);
+    return out;
+}
+
+std::vector<PreparedPose> PrepareSession(const Session& session, const MeasureConfig& config) {
+    std::vector<PreparedPose> prepared(session.poses.size());
+    ParallelFor(static_cast<int>(prepared.size()), config.threads, [&](int k) {
+        const auto i = static_cast<std::size_t>(k);
+        prepared[i] = PreparePose(session.poses[i].frames, session.camera.depth_unit_m, config);
+    });
+    return prepared;
+}
+
+Result<std::vector<DepthMap>> UsableDepths(std::vector<PreparedPose> poses,
+                                           const RefusalConfig& refuse) {
+    if (poses.empty()) return Error{ErrorCode::kInsufficientData, "the session has no poses"};
+    std::vector<DepthMap> depths(poses.size());
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+        if (!poses[i].error.empty()) {
+            return Error{ErrorCode::kInsufficientData,
+                         fmt::format("pose {}: {}", i, poses[i].error)};
+        }
+        depths[i] = std::move(poses[i].depth);
+        const double valid = ValidFraction(depths[i]);
+        if (valid < refuse.min_pose_valid_fraction) {
+            return Error{ErrorCode::kInsufficientData,
+                         fmt::format("pose {} has valid depth readings in only {:.1f}% of its pixels",
+                                     i, 100.0 * valid)};
+        }
+    }
+    return depths;
+}
+
+}  // namespace boxd

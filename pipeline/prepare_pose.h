@@ -1,0 +1,35 @@
+#pragma once
+// Stage 1: one pose's frames averaged (AverageDepthFrames) and cleared of flying pixels
+// (RemoveFlyingPixels). The only stage that needs nothing but the pose's own frames, so a
+// capture runs it while the table moves on; every later stage needs all poses.
+
+#include <string>
+#include <vector>
+
+#include "pipeline/depth_image.h"
+#include "pipeline/measure_config.h"
+#include "pipeline/result.h"
+#include "pipeline/session.h"
+
+namespace boxd {
+
+struct PreparedPose {
+    DepthMap depth;
+    std::string error;  // why the frames could not be averaged (empty when they could)
+};
+
+// Returns `frames` (of a camera with `depth_unit_m`) through the first stage.
+// (config.averaging, config.flying_pixels).
+PreparedPose PreparePose(const std::vector<DepthImage>& frames, double depth_unit_m,
+                         const MeasureConfig& config);
+
+// Returns every pose of `session` through PreparePose, on config.threads threads.
+std::vector<PreparedPose> PrepareSession(const Session& session, const MeasureConfig& config);
+
+// Returns the prepared poses' depth maps in pose order, or INSUFFICIENT_DATA naming the pose
+// that cannot be used (its frames could not be averaged, or too few of its pixels have a
+// reading).
+Result<std::vector<DepthMap>> UsableDepths(std::vector<PreparedPose> poses,
+                                           const RefusalConfig& refuse);
+
+}  // namespace boxd

@@ -1,0 +1,119 @@
+#include "pipeline/refusal.h"
+
+#include <spdlog/fmt/fmt.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace boxd {
+
+namespace {
+
+MeasurementReason Moved(const std::string& why) {
+    return MeasurementReason{ErrorCode::kObjectMoved, why + ": the object moved on the table"};
+}
+
+}  // namespace
+
+Status RefusalConfig::Validate() const {
+    auto bad = [](const std::string& f, const std::string& why) -> Status {
+        return Error{ErrorCode::kInvalidConfig, "refusal." + f + ": " + why};
+    };
+    if (!(min_pose_valid_fraction >= 0.0 && min_pose_valid_fraction < 1.0)) {
+        return bad("min_pose_valid_fraction", "must be in [0, 1)");
+    }
+    if (min_object_points < 10) return bad("min_object_points", "must be >= 10");
+    if (max_border_points < 0) return bad("max_border_points", "must be >= 0");
+    if (max_outside_points < 0) return bad("max_outside_points", "must be >= 0");
+    if (!(min_dimension_m > 0.0)) return bad("min_dimension_m", "must be > 0");
+    if (!(max_registration_rmse_m > 0.0)) return bad("max_registration_rmse_m", "must be > 0");
+    if (!(max_rejected_edge_fraction >= 0.0 && max_rejected_edge_fraction <= 1.0)) {
+        return bad("max_rejected_edge_fraction", "must be in [0, 1]");
+    }
+    if (!(max_unconstrained_fraction >= 0.0 && max_unconstrained_fraction <= 1.0)) {
+        return bad("max_unconstrained_fraction", "must be in [0, 1]");
+    }
+    if (!(max_model_yaw_deviation_deg > 0.0)) return bad("max_model_yaw_deviation_deg", "> 0");
+    if (!(max_model_translation_deviation_m > 0.0)) {
+        return bad("max_model_translation_deviation_m", "must be > 0");
+    }
+    if (!(max_face_sigma_m > 0.0)) return bad("max_face_sigma_m", "must be > 0");
+    return OkStatus();
+}
+
+std::optional<MeasurementReason> CheckObjectViews(const ObjectViews& views,
+                                                  const RefusalConfig& refuse) {
+    for (std::size_t k = 0; k < views.views.size(); ++k) {
+        const SegmentedView& v = views.views[k];
+        if (v.border_points > refuse.max_border_points) {
+            return MeasurementReason{ErrorCode::kObjectTooLarge,
+                                     fmt::format("the object is cut by the image border in pose {}", k)};
+        }
+        if (v.outside_points > refuse.max_outside_points) {
+            return MeasurementReason{
+                ErrorCode::kObjectTooLarge,
+                fmt::format("the object leaves the measuring volume in pose {}", k)};
+        }
+    }
+    if (views.fusion_points < refuse.min_object_points) {
+        return MeasurementReason{ErrorCode::kNoObject, "nothing stands on the table"};
+    }
+    return std::nullopt;
+}
+
+std::optional<MeasurementReason> CheckRegisteredViews(const RegisteredViews& registered, int poses,
+                                                      const RefusalConfig& refuse) {
+    if (poses < 2) return std::nullopt;
+    const PoseGraphReport& report = registered.graph;
+    const double yaw_deg = report.max_model_yaw_deviation_rad * 180.0 / M_PI;
+    if (yaw_deg > refuse.max_model_yaw_deviation_deg ||
+        report.max_model_translation_deviation_m > refuse.max_model_translation_deviation_m) {
+        return Moved(fmt::format("the views disagree with the turntable motion ({:.1f} deg, {:.1f} mm)",
+                                 yaw_deg, report.max_model_translation_deviation_m * 1000.0));
+    }
+    const int edges = report.rejected_edges + report.active_edges;
+    if (edges > 0 && report.rejected_edges > refuse.max_rejected_edge_fraction * edges) {
+        return Moved(fmt::format("{} of {} view alignments disagree with the others",
+                                 report.rejected_edges, edges));
+    }
+    if (report.active_edges == 0 ||
+        report.unconstrained_nodes > refuse.max_unconstrained_fraction * poses) {
+        return MeasurementReason{
+            ErrorCode::kRegistrationFailed,
+            fmt::format("too few views could be registered ({} of {} unregistered)",
+                        report.unconstrained_nodes, poses)};
+    }
+    if (registered.edges.mean_rmse_m > refuse.max_registration_rmse_m) {
+        return MeasurementReason{ErrorCode::kRegistrationFailed,
+                                 fmt::format("the views do not align (RMSE {:.1f} mm)",
+                                             registered.edges.mean_rmse_m * 1000.0)};
+    }
+    return std::nullopt;
+}
+
+std::optional<MeasurementReason> CheckFusedFit(const FusedFit& fit, const RefusalConfig& refuse) {
+    if (static_cast<long>(fit.fused.points.size()) < refuse.min_object_points) {
+        return MeasurementReason{ErrorCode::kNoObject, "nothing stands on the table"};
+    }
+    if (!fit.box) return fit.box.error();
+    const BoxFit& box = *fit.box;
+    if (std::min(box.width_m, box.height_m) < refuse.min_dimension_m) {
+        return MeasurementReason{
+            ErrorCode::kObjectTooSmall,
+            fmt::format("the object is smaller than {:.0f} mm", refuse.min_dimension_m * 1000.0)};
+    }
+    const ConsistencyReport& c = fit.consistency;
+    if (!c.inconsistent_views.empty()) {
+        return Moved(fmt::format("view {} disagrees with the others ({:.0f}% of its points on the box)",
+                                 c.worst_view, 100.0 * c.worst_inlier_fraction));
+    }
+    if (box.face_sigma_m > refuse.max_face_sigma_m) {
+        return MeasurementReason{
+            ErrorCode::kRegistrationFailed,
+            fmt::format("the box faces are not flat to {:.0f} mm (sigma {:.1f} mm)",
+                        refuse.max_face_sigma_m * 1000.0, box.face_sigma_m * 1000.0)};
+    }
+    return std::nullopt;
+}
+
+}  // namespace boxd

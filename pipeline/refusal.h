@@ -1,0 +1,54 @@
+#pragma once
+// The refusal rules: when the measurement gives no size rather than a wrong one (SPEC section 5:
+// a confident wrong size costs a carrier money, a no_dim costs a re-scan). Every rule the recipe
+// applies is here, in the order the stages reach them; each returns the reason, or nullopt.
+
+#include <optional>
+
+#include "pipeline/fuse_and_fit.h"
+#include "pipeline/measurement.h"
+#include "pipeline/object_views.h"
+#include "pipeline/register_views.h"
+#include "pipeline/result.h"
+
+namespace boxd {
+
+struct RefusalConfig {
+    double min_pose_valid_fraction = 0.05;  // a pose with fewer valid pixels has no usable data
+    int min_object_points = 400;            // fewer fused object points: NO_OBJECT
+    int max_border_points = 40;     // object readings at the image border in one view: cut off
+    int max_outside_points = 60;    // readings above the table just outside the measuring cylinder
+    double min_dimension_m = 0.03;  // a smaller side: OBJECT_TOO_SMALL
+    double max_registration_rmse_m = 0.004;    // mean ICP RMSE of the kept edges
+    double max_unconstrained_fraction = 0.25;  // views without any kept edge
+    // More alignments than this fraction disagreeing with the rest: the views show the object
+    // in two places (it moved), and no single size describes them.
+    double max_rejected_edge_fraction = 0.2;
+    double max_model_yaw_deviation_deg = 3.0;  // registered poses vs the turntable model ...
+    double max_model_translation_deviation_m = 0.015;  // ... beyond these: OBJECT_MOVED
+    // Box faces rougher than this (robust sigma of the face fits) are not faces of one rigid box
+    // seen from registered views.
+    double max_face_sigma_m = 0.01;
+
+    // Returns an error naming the first invalid field, or Ok.
+    Status Validate() const;
+};
+
+// Object views: OBJECT_TOO_LARGE when the object is cut by the image border or leaves the
+// measuring volume in a view, NO_OBJECT when too few object points are seen at all.
+std::optional<MeasurementReason> CheckObjectViews(const ObjectViews& views,
+                                                  const RefusalConfig& refuse);
+
+// Registered views (of `poses` views; a single view is not judged): OBJECT_MOVED when the
+// registered poses leave the turntable model or too many alignments disagree with the rest (the
+// views show the object in two places), REGISTRATION_FAILED when too few views are registered
+// or the views do not align.
+std::optional<MeasurementReason> CheckRegisteredViews(const RegisteredViews& registered, int poses,
+                                                      const RefusalConfig& refuse);
+
+// The fused cloud and its box: NO_OBJECT when too few points survive fusion, the fit's own
+// error, OBJECT_TOO_SMALL, OBJECT_MOVED when a view disagrees with the box, REGISTRATION_FAILED
+// when the faces are not flat.
+std::optional<MeasurementReason> CheckFusedFit(const FusedFit& fit, const RefusalConfig& refuse);
+
+}  // namespace boxd
