@@ -1,0 +1,194 @@
+#include "pipeline/table_plane.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace boxd {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+// Error codes are compared as strings only here (they will become an enum).
+template <typename T>
+void ExpectError(const Result<T>& r, const char* code) {
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().code, code);
+}
+
+// The recorded calibration of these tests: the camera looks 45 degrees down at a table centre
+// 0.9 m in front of it, so the whole fit disc is in view.
+StationCalibration Recorded() {
+    StationCalibration c;
+    c.table_center_m = {0.0, 0.0, 0.9};
+    c.table_axis = Eigen::Vector3d(0.0, -1.0, -1.0).normalized();
+    return c;
+}
+
+// A box standing on the table, axis-aligned in the table frame.
+struct Box {
+    Eigen::Vector2d center = Eigen::Vector2d::Zero();
+    double half_l = 0.0, half_w = 0.0, height = 0.0;
+};
+
+// Returns the ray parameter of the first hit of `box` by o + t d (slab method), or +inf.
+double HitBox(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const Box& box) {
+    const Eigen::Vector3d lo(box.center.x() - box.half_l, box.center.y() - box.half_w, 0.0);
+    const Eigen::Vector3d hi(box.center.x() + box.half_l, box.center.y() + box.half_w, box.height);
+    double t0 = 0.0, t1 = std::numeric_limits<double>::infinity();
+    for (int a = 0; a < 3; ++a) {
+        if (std::abs(d[a]) < 1e-12) {
+            if (o[a] < lo[a] || o[a] > hi[a]) return std::numeric_limits<double>::infinity();
+            continue;
+        }
+        double ta = (lo[a] - o[a]) / d[a], tb = (hi[a] - o[a]) / d[a];
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+    }
+    return t0 <= t1 ? t0 : std::numeric_limits<double>::infinity();
+}
+
+// Renders the z-depth map the camera sees of the table plane z = 0 (a disc of `table_radius`)
+// and an optional box, both in the table frame given by `camera_to_table`. Every pixel ray has
+// camera-frame z = 1, so its ray parameter is the z-depth.
+DepthMap Render(const CameraIntrinsics& cam, const Eigen::Isometry3d& camera_to_table,
+                const Box* box, double table_radius = 0.5) {
+    DepthMap depth(cam.width, cam.height);
+    const Eigen::Vector3d o = camera_to_table.translation();
+    for (int v = 0; v < cam.height; ++v) {
+        for (int u = 0; u < cam.width; ++u) {
+            const Eigen::Vector3d d = camera_to_table.linear() * cam.BackProject(u, v, 1.0);
+            double t = std::numeric_limits<double>::infinity();
+            if (d.z() < 0.0) {
+                const double tp = -o.z() / d.z();
+                if ((o + tp * d).head<2>().norm() < table_radius) t = tp;
+            }
+            if (box) t = std::min(t, HitBox(o, d, *box));
+            if (std::isfinite(t)) depth.at(u, v) = static_cast<float>(t);
+        }
+    }
+    return depth;
+}
+
+// The true table: the recorded one tilted by `tilt` about the in-plane direction at 30 degrees
+// and raised by `raise` along the recorded axis. Returns recorded-table -> true-table.
+Eigen::Isometry3d TrueFromRecorded(double tilt, double raise) {
+    const Eigen::Matrix3d q =
+        Eigen::AngleAxisd(tilt, Eigen::Vector3d(std::cos(30 * kDeg), std::sin(30 * kDeg), 0.0))
+            .toRotationMatrix();
+    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+    t.linear() = q.transpose();
+    t.translation() = -q.transpose() * Eigen::Vector3d(0.0, 0.0, raise);
+    return t;
+}
+
+TEST(BackProjectDepth, AppliesStrideAndDepthCorrection) {
+    CameraIntrinsics cam;
+    cam.width = 4;
+    cam.height = 3;
+    cam.fx = 100.0;
+    cam.fy = 200.0;
+    cam.cx = 1.5;
+    cam.cy = 1.0;
+    StationCalibration cal;
+    cal.depth_offset_m = 0.01;
+    cal.depth_scale = 1.02;
+    DepthMap depth(4, 3);
+    depth.at(0, 0) = 1.0f;   // corrected 1.03
+    depth.at(2, 0) = 0.5f;   // corrected 0.52
+    depth.at(1, 1) = 2.0f;   // off the stride-2 grid
+    depth.at(2, 2) = 0.0f;   // no reading
+    depth.at(0, 2) = -1.0f;  // invalid reading
+    const Points all = BackProjectDepth(depth, cam, cal, 1);
+    ASSERT_EQ(all.size(), 3u);
+    const Points strided = BackProjectDepth(depth, cam, cal, 2);
+    ASSERT_EQ(strided.size(), 2u);
+    // x = (u - cx) / fx * z, y = (v - cy) / fy * z with the corrected z.
+    EXPECT_NEAR(strided[0].x(), -1.5 / 100.0 * 1.03, 1e-6);
+    EXPECT_NEAR(strided[0].y(), -1.0 / 200.0 * 1.03, 1e-6);
+    EXPECT_NEAR(strided[0].z(), 1.03, 1e-6);
+    EXPECT_NEAR(strided[1].x(), 0.5 / 100.0 * 0.52, 1e-6);
+    EXPECT_NEAR(strided[1].z(), 0.52, 1e-6);
+    EXPECT_NEAR(all[2].z(), 2.05, 1e-6);  // row-major order: (1, 1) comes last
+}
+
+TEST(FitTablePlane, RecoversKnownTiltAndHeightCorrection) {
+    const CameraIntrinsics cam;
+    const StationCalibration recorded = Recorded();
+    const double tilt = 1.5 * kDeg, raise = 0.004;
+    const Eigen::Isometry3d true_from_rec = TrueFromRecorded(tilt, raise);
+    const Eigen::Isometry3d cam_to_true = true_from_rec * recorded.CameraToTable();
+    // A box on the table: its faces near the table top must be trimmed, not bias the plane.
+    const Box box{{0.05, -0.02}, 0.1, 0.08, 0.12};
+    const std::vector<DepthMap> depths = {Render(cam, cam_to_true, &box)};
+
+    auto fit = FitTablePlane(depths, cam, recorded, TablePlaneConfig{});
+    ASSERT_TRUE(fit.ok()) << fit.error().message;
+    // Noise-free floats: back-projection rounds at ~1e-7 m, so 1e-5 m and 1e-3 degrees (1.7e-5
+    // rad over a 0.3 m disc is 5e-6 m) leave room without hiding a wrong plane.
+    EXPECT_NEAR(fit->tilt_correction_deg, 1.5, 1e-3);
+    // The recorded origin lies `raise` below the plane along the recorded axis, i.e.
+    // raise * cos(tilt) below it along the true normal.
+    EXPECT_NEAR(fit->height_correction_m, -raise * std::cos(tilt), 1e-5);
+    EXPECT_GE(fit->points, TablePlaneConfig{}.min_points);
+
+    // The refined frame: +z is the true normal, true table points are at z = 0, the origin is
+    // the recorded centre projected onto the true plane, +x the recorded x projected.
+    const Eigen::Isometry3d true_to_cam = cam_to_true.inverse();
+    const Eigen::Vector3d n = true_to_cam.linear().col(2);
+    const Eigen::Vector3d p0 = true_to_cam.translation();
+    EXPECT_LT((fit->camera_to_table.linear().transpose().col(2) - n).norm(), 1e-5);
+    for (const Eigen::Vector2d& xy : {Eigen::Vector2d(0.2, 0.1), Eigen::Vector2d(-0.25, 0.15)}) {
+        const Eigen::Vector3d on_plane = true_to_cam * Eigen::Vector3d(xy.x(), xy.y(), 0.0);
+        EXPECT_NEAR((fit->camera_to_table * on_plane).z(), 0.0, 1e-5);
+    }
+    const Eigen::Vector3d c = recorded.table_center_m;
+    const Eigen::Vector3d origin = c - n.dot(c - p0) * n;
+    EXPECT_LT((fit->camera_to_table * origin).norm(), 1e-5);
+    const Eigen::Vector3d x_rec = recorded.CameraToTable().linear().row(0).transpose();
+    const Eigen::Vector3d x_exp = (x_rec - x_rec.dot(n) * n).normalized();
+    EXPECT_LT((fit->camera_to_table.linear().row(0).transpose() - x_exp).norm(), 1e-5);
+}
+
+TEST(FitTablePlane, ExactCalibrationNeedsNoCorrection) {
+    const CameraIntrinsics cam;
+    const StationCalibration recorded = Recorded();
+    const std::vector<DepthMap> depths = {Render(cam, recorded.CameraToTable(), nullptr)};
+    auto fit = FitTablePlane(depths, cam, recorded, TablePlaneConfig{});
+    ASSERT_TRUE(fit.ok()) << fit.error().message;
+    EXPECT_NEAR(fit->tilt_correction_deg, 0.0, 1e-3);
+    EXPECT_NEAR(fit->height_correction_m, 0.0, 1e-5);
+    EXPECT_TRUE(fit->camera_to_table.isApprox(recorded.CameraToTable(), 1e-5));
+}
+
+TEST(FitTablePlane, TooFewTablePointsIsAnError) {
+    const CameraIntrinsics cam;
+    const StationCalibration recorded = Recorded();
+    // A 0.03 m disc covers ~800 pixels (1.6 x 2.2 mm each at 0.9 m and 45 degrees); the stride
+    // of 3 in each direction leaves ~90, far below the 300 needed.
+    const std::vector<DepthMap> depths = {Render(cam, recorded.CameraToTable(), nullptr, 0.03)};
+    ExpectError(FitTablePlane(depths, cam, recorded, TablePlaneConfig{}), "INSUFFICIENT_DATA");
+}
+
+TEST(FitTablePlane, CorrectionBeyondMaxTiltIsAnError) {
+    const CameraIntrinsics cam;
+    const StationCalibration recorded = Recorded();
+    const Eigen::Isometry3d cam_to_true =
+        TrueFromRecorded(4.0 * kDeg, 0.0) * recorded.CameraToTable();
+    const std::vector<DepthMap> depths = {Render(cam, cam_to_true, nullptr)};
+    TablePlaneConfig config;
+    config.search_band_m = 0.06;  // 4 degrees over the 0.34 m disc reach 24 mm: keep them all
+    config.max_tilt_deg = 3.0;
+    ExpectError(FitTablePlane(depths, cam, recorded, config), "REGISTRATION_FAILED");
+    // The same data pass once the limit allows 4 degrees: the limit is what refused them.
+    config.max_tilt_deg = 5.0;
+    auto fit = FitTablePlane(depths, cam, recorded, config);
+    ASSERT_TRUE(fit.ok()) << fit.error().message;
+    EXPECT_NEAR(fit->tilt_correction_deg, 4.0, 1e-3);
+}
+
+}  // namespace
+}  // namespace boxd

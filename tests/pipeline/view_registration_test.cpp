@@ -1,0 +1,211 @@
+#include "pipeline/view_registration.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <set>
+#include <utility>
+
+namespace boxd {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr int kViews = 8;
+
+// The scene: a 0.30 x 0.20 x 0.15 m box off the axis, turned by the table about a true centre
+// 4 mm / -3 mm off the calibrated axis and by angles that miss the commanded 45-degree steps by
+// up to half a degree. The turntable model is then 4 - 7 mm and up to 0.8 degrees off per pair:
+// ICP has to find the rest.
+const Eigen::Vector2d kTrueCentre(0.004, -0.003);
+const double kAngleErrorDeg[kViews] = {0.0, 0.4, -0.3, 0.5, -0.2, 0.3, -0.4, 0.2};
+
+double Commanded(int k) { return 45.0 * kDeg * k; }
+double TrueAngle(int k) { return Commanded(k) + kAngleErrorDeg[k] * kDeg; }
+
+// Node k's true pose: maps view k back into the frame of pose 0.
+Se2 TruePose(int k) { return Se2::RotationAbout(-TrueAngle(k), kTrueCentre); }
+
+constexpr double kBoxYaw = 0.3;
+
+// The outward normal of side face f of the box (0: +u, 1: +v, 2: -u, 3: -v) in the table frame
+// with the table at `angle`.
+Eigen::Vector2d FaceNormal(int f, double angle) {
+    const double a = kBoxYaw + angle + f * M_PI / 2;
+    return {std::cos(a), std::sin(a)};
+}
+
+// Whether the camera (looking along +y from above) sees side face f with the table at `angle`:
+// it faces the camera, not at grazing incidence.
+bool Visible(int f, double angle) {
+    return FaceNormal(f, angle).dot(Eigen::Vector2d(0.0, -1.0)) >= 0.1;
+}
+
+// The faces of the box the camera sees with the table at `angle`: the top and the visible
+// sides, sampled every 2 mm with 0.5 mm sensor noise along the face normal.
+Points BoxView(double angle, unsigned seed) {
+    const double l = 0.30, w = 0.20, h = 0.15, step = 0.002;
+    const Eigen::Vector2d centre(0.03, -0.02);
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, 0.0005);
+    const Se2 box_to_table =
+        Se2::RotationAbout(angle, kTrueCentre).Compose(Se2{centre.x(), centre.y(), kBoxYaw});
+    Points pts;
+    auto side = [&](double u, double v, double z, int f) {
+        if (!Visible(f, angle)) return;
+        const Eigen::Vector2d q =
+            box_to_table.Apply(Eigen::Vector2d(u, v)) + noise(rng) * FaceNormal(f, angle);
+        pts.emplace_back(q.x(), q.y(), z);
+    };
+    for (double z = step / 2; z < h; z += step) {
+        for (double v = -w / 2; v <= w / 2; v += step) {
+            side(l / 2, v, z, 0);
+            side(-l / 2, v, z, 2);
+        }
+        for (double u = -l / 2; u <= l / 2; u += step) {
+            side(u, w / 2, z, 1);
+            side(u, -w / 2, z, 3);
+        }
+    }
+    for (double u = -l / 2; u <= l / 2; u += step) {
+        for (double v = -w / 2; v <= w / 2; v += step) {
+            const Eigen::Vector2d p = box_to_table.Apply(Eigen::Vector2d(u, v));
+            pts.emplace_back(p.x(), p.y(), h + noise(rng));
+        }
+    }
+    return pts;
+}
+
+// Whether views i and j share two (adjacent, so perpendicular) side faces: then the data fix
+// all of (x, y, yaw). With one shared face a view may slide along it (the top is horizontal and
+// says nothing about the motion), which the pose graph fills in from the turntable model.
+bool SharesTwoFaces(int i, int j) {
+    int shared = 0;
+    for (int f = 0; f < 4; ++f) shared += Visible(f, TrueAngle(i)) && Visible(f, TrueAngle(j));
+    return shared >= 2;
+}
+
+std::set<std::pair<int, int>> EdgeSet(const std::vector<PoseEdge>& edges) {
+    std::set<std::pair<int, int>> s;
+    for (const PoseEdge& e : edges) s.insert({e.from, e.to});
+    return s;
+}
+
+class RegisterViewPairsTest : public ::testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        const RegistrationConfig config;
+        views_ = new std::vector<ViewClouds>();
+        angles_ = new std::vector<double>();
+        for (int k = 0; k < kViews; ++k) {
+            views_->push_back(BuildRegistrationClouds(BoxView(TrueAngle(k), 100 + k),
+                                                      config.coarse_cloud, config.fine_cloud));
+            angles_->push_back(Commanded(k));
+        }
+    }
+    static void TearDownTestSuite() {
+        delete views_;
+        delete angles_;
+    }
+    static std::vector<ViewClouds>* views_;
+    static std::vector<double>* angles_;
+};
+
+std::vector<ViewClouds>* RegisterViewPairsTest::views_ = nullptr;
+std::vector<double>* RegisterViewPairsTest::angles_ = nullptr;
+
+TEST(TurntablePoses, RotatesBackByTheAngleRelativeToPoseZero) {
+    const std::vector<Se2> poses = TurntablePoses({0.1, 0.6, 3.5, 0.1 + 2.0 * M_PI});
+    ASSERT_EQ(poses.size(), 4u);
+    for (const Se2& p : poses) {
+        EXPECT_EQ(p.x, 0.0);
+        EXPECT_EQ(p.y, 0.0);
+    }
+    EXPECT_NEAR(poses[0].yaw, 0.0, 1e-12);
+    EXPECT_NEAR(poses[1].yaw, -0.5, 1e-12);
+    EXPECT_NEAR(poses[2].yaw, 2.0 * M_PI - 3.4, 1e-12);  // -3.4 wrapped into (-pi, pi]
+    EXPECT_NEAR(poses[3].yaw, 0.0, 1e-12);               // a full turn is no turn
+}
+
+TEST_F(RegisterViewPairsTest, EdgesMatchTheTrueRelativePoses) {
+    EdgeStats stats;
+    const std::vector<PoseEdge> edges =
+        RegisterViewPairs(*views_, *angles_, RegistrationConfig{}, &stats);
+    // Steps 1 and 2 (45 and 90 degrees) of every pose; step 3 (135) exceeds the 100 limit.
+    std::set<std::pair<int, int>> expected;
+    for (int i = 0; i < kViews; ++i) {
+        for (int step = 1; step <= 2; ++step) {
+            const int j = (i + step) % kViews;
+            expected.insert({std::min(i, j), std::max(i, j)});
+        }
+    }
+    EXPECT_EQ(stats.attempted, 16);
+    EXPECT_EQ(stats.accepted, 16);
+    EXPECT_EQ(EdgeSet(edges), expected);
+    int full = 0;
+    for (const PoseEdge& e : edges) {
+        EXPECT_EQ(e.loop_closure, e.to != e.from + 1) << e.from << "-" << e.to;
+        const Se2 truth = TruePose(e.from).Inverse().Compose(TruePose(e.to));
+        const Eigen::Vector3d d = Se2Difference(e.measured, truth);
+        // The model starts each pair 3.8 - 7.1 mm and up to 0.8 degrees off, moving the surfaces
+        // by 2.4 - 7.1 mm RMS along their normals. Every edge must bring that surface
+        // displacement (what the pose graph judges edges by) below half its 1 mm edge sigma.
+        EXPECT_LT(std::sqrt(d.dot(e.point_scatter * d)), 0.0005) << e.from << "-" << e.to;
+        if (SharesTwoFaces(e.from, e.to)) {
+            ++full;
+            // Fully constrained pairs must match the whole motion: 0.5 mm and 0.05 degrees
+            // (0.17 mm at the box's 0.2 m reach) is the millimetre budget of a measurement,
+            // far above the noise's share (0.5 mm / sqrt(~1000 points)).
+            EXPECT_LT(d.head<2>().norm(), 0.0005) << e.from << "-" << e.to;
+            EXPECT_LT(std::abs(d.z()), 0.05 * kDeg) << e.from << "-" << e.to;
+        }
+    }
+    // With the box at 17 degrees and 45-degree steps, the pairs (0,1), (2,3), (4,5), (6,7) see
+    // the same two faces; all other pairs share one.
+    EXPECT_EQ(full, 4);
+    EXPECT_GT(stats.mean_rmse_m, 0.0);
+    EXPECT_LT(stats.mean_rmse_m, RegistrationConfig{}.max_rmse_m);
+}
+
+TEST_F(RegisterViewPairsTest, MaxPoseStepLimitsThePairs) {
+    RegistrationConfig config;
+    config.max_pose_step = 1;
+    EdgeStats stats;
+    const std::vector<PoseEdge> edges = RegisterViewPairs(*views_, *angles_, config, &stats);
+    std::set<std::pair<int, int>> expected;
+    for (int i = 0; i + 1 < kViews; ++i) expected.insert({i, i + 1});
+    expected.insert({0, kViews - 1});  // last-to-first closes the ring
+    EXPECT_EQ(stats.attempted, kViews);
+    EXPECT_EQ(EdgeSet(edges), expected);
+    for (const PoseEdge& e : edges) EXPECT_EQ(e.loop_closure, e.from == 0 && e.to == kViews - 1);
+}
+
+TEST_F(RegisterViewPairsTest, MaxPairAngleLimitsThePairs) {
+    RegistrationConfig config;
+    config.max_pair_angle_deg = 40.0;  // below the 45-degree step: no pair qualifies
+    EdgeStats stats;
+    EXPECT_TRUE(RegisterViewPairs(*views_, *angles_, config, &stats).empty());
+    EXPECT_EQ(stats.attempted, 0);
+    config.max_pair_angle_deg = 50.0;
+    EXPECT_EQ(RegisterViewPairs(*views_, *angles_, config, &stats).size(), 8u);
+}
+
+TEST_F(RegisterViewPairsTest, PairThatCannotAlignIsLeftOut) {
+    std::vector<ViewClouds> views = *views_;
+    // View 3 shows the box half a metre away: nothing lies within the 2 cm correspondence gate.
+    const RegistrationConfig config;
+    Points moved = BoxView(TrueAngle(3), 103);
+    for (Eigen::Vector3f& p : moved) p.x() += 0.5f;
+    views[3] = BuildRegistrationClouds(moved, config.coarse_cloud, config.fine_cloud);
+    EdgeStats stats;
+    const std::vector<PoseEdge> edges = RegisterViewPairs(views, *angles_, config, &stats);
+    EXPECT_EQ(stats.attempted, 16);
+    EXPECT_EQ(stats.accepted, 12);  // (1,3), (2,3), (3,4) and (3,5) are gone
+    for (const PoseEdge& e : edges) {
+        EXPECT_NE(e.from, 3);
+        EXPECT_NE(e.to, 3);
+    }
+}
+
+}  // namespace
+}  // namespace boxd

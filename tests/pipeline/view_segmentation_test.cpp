@@ -1,0 +1,148 @@
+#include "pipeline/view_segmentation.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace boxd {
+namespace {
+
+// A small camera looking straight down at the table from kCameraHeight: table x = camera x,
+// table y = -camera y, table z = kCameraHeight - camera z. A reading of depth z at pixel (u, v)
+// is the table point ((u - cx) / fx * z, -(v - cy) / fy * z, kCameraHeight - z).
+constexpr double kCameraHeight = 1.0;
+
+CameraIntrinsics SmallCamera() {
+    CameraIntrinsics cam;
+    cam.width = 64;
+    cam.height = 48;
+    cam.fx = 50.0;
+    cam.fy = 50.0;
+    cam.cx = 31.5;
+    cam.cy = 23.5;
+    return cam;
+}
+
+Eigen::Isometry3d LookingDown() {
+    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+    t.linear() = Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
+    t.translation() = Eigen::Vector3d(0.0, 0.0, kCameraHeight);
+    return t;
+}
+
+// The bare table top: every pixel reads the camera height.
+DepthMap Table(const CameraIntrinsics& cam) {
+    DepthMap d(cam.width, cam.height);
+    for (float& z : d.z_m) z = static_cast<float>(kCameraHeight);
+    return d;
+}
+
+// Raises the pixels [u0, u1) x [v0, v1) to `height` above the table.
+void Raise(DepthMap& d, int u0, int u1, int v0, int v1, double height) {
+    for (int v = v0; v < v1; ++v) {
+        for (int u = u0; u < u1; ++u) d.at(u, v) = static_cast<float>(kCameraHeight - height);
+    }
+}
+
+// The measuring volume of these tests: a 0.3 m cylinder with a 0.1 m outside band.
+SegmentationConfig SmallVolume() {
+    SegmentationConfig c;
+    c.cylinder_radius_m = 0.3;
+    c.outside_band_m = 0.1;
+    return c;
+}
+
+TEST(SegmentView, BareTableHasNoObjectPoints) {
+    const CameraIntrinsics cam = SmallCamera();
+    const SegmentedView view =
+        SegmentView(Table(cam), cam, StationCalibration{}, LookingDown(), SmallVolume());
+    EXPECT_EQ(view.valid_pixels, 64 * 48);
+    EXPECT_TRUE(view.points.empty());
+    EXPECT_EQ(view.outside_points, 0);
+    EXPECT_EQ(view.border_points, 0);
+}
+
+TEST(SegmentView, KeepsBoxAboveMinHeightWithFusionStrideSubset) {
+    const CameraIntrinsics cam = SmallCamera();
+    DepthMap depth = Table(cam);
+    // Box top 0.1 m high over u in [20, 40), v in [15, 30): at depth 0.9 m its farthest pixel
+    // (20, 15) is at radius hypot(0.207, 0.153) = 0.26 m, inside the 0.3 m cylinder.
+    Raise(depth, 20, 40, 15, 30, 0.1);
+    // A 5 mm bump is below min_height (8 mm): table, not object.
+    Raise(depth, 5, 10, 5, 10, 0.005);
+    depth.at(0, 47) = 0.0f;  // a missing reading
+    const SegmentedView view =
+        SegmentView(depth, cam, StationCalibration{}, LookingDown(), SmallVolume());
+    EXPECT_EQ(view.valid_pixels, 64 * 48 - 1);
+    ASSERT_EQ(view.points.size(), 20u * 15u);
+    // Row-major order: the first point is pixel (20, 15) at depth 0.9.
+    EXPECT_NEAR(view.points[0].x(), (20 - 31.5) / 50.0 * 0.9, 1e-5);
+    EXPECT_NEAR(view.points[0].y(), -(15 - 23.5) / 50.0 * 0.9, 1e-5);
+    for (const Eigen::Vector3f& p : view.points) EXPECT_NEAR(p.z(), 0.1, 1e-5);
+    // Stride 3: u in {21, 24, ..., 39} (7) times v in {15, 18, ..., 27} (5).
+    ASSERT_EQ(view.fusion_points.size(), 35u);
+    EXPECT_NEAR(view.fusion_points[0].x(), (21 - 31.5) / 50.0 * 0.9, 1e-5);
+    EXPECT_NEAR(view.fusion_points[0].y(), -(15 - 23.5) / 50.0 * 0.9, 1e-5);
+    EXPECT_EQ(view.border_points, 0);
+    EXPECT_EQ(view.outside_points, 0);
+}
+
+TEST(SegmentView, AppliesDepthCorrectionAndTableFrame) {
+    const CameraIntrinsics cam = SmallCamera();
+    // The camera reads 5 mm short: raw = true - 0.005, corrected back by the offset.
+    StationCalibration cal;
+    cal.depth_offset_m = 0.005;
+    DepthMap depth(cam.width, cam.height);
+    depth.at(40, 30) = static_cast<float>(0.8 - 0.005);  // 0.2 m above the table
+    depth.at(41, 30) = static_cast<float>(1.0 - 0.005);  // table
+    // The table frame turned by 90 degrees about its axis: table (x, y) -> (-y, x).
+    Eigen::Isometry3d turn = Eigen::Isometry3d::Identity();
+    turn.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const SegmentedView view = SegmentView(depth, cam, cal, turn * LookingDown(), SmallVolume());
+    EXPECT_EQ(view.valid_pixels, 2);
+    ASSERT_EQ(view.points.size(), 1u);
+    const double x = (40 - 31.5) / 50.0 * 0.8, y = -(30 - 23.5) / 50.0 * 0.8;
+    EXPECT_NEAR(view.points[0].x(), -y, 1e-5);
+    EXPECT_NEAR(view.points[0].y(), x, 1e-5);
+    EXPECT_NEAR(view.points[0].z(), 0.2, 1e-5);
+}
+
+TEST(SegmentView, CountsObjectReadingsAtTheImageBorder) {
+    const CameraIntrinsics cam = SmallCamera();
+    DepthMap depth = Table(cam);
+    // Object pixels u in [0, 5), v in [20, 28); with a 2 px margin, columns 0 and 1 are cut.
+    Raise(depth, 0, 5, 20, 28, 0.1);
+    SegmentationConfig config = SmallVolume();
+    config.cylinder_radius_m = 0.8;  // the image corners are at 0.71 m: all inside
+    const SegmentedView view = SegmentView(depth, cam, StationCalibration{}, LookingDown(), config);
+    EXPECT_EQ(view.points.size(), 5u * 8u);
+    EXPECT_EQ(view.border_points, 2 * 8);
+    EXPECT_EQ(view.outside_points, 0);
+}
+
+TEST(SegmentView, CountsReadingsJustOutsideTheCylinder) {
+    const CameraIntrinsics cam = SmallCamera();
+    DepthMap depth = Table(cam);
+    // At depth 0.9 m, u in [50, 54) spans x = 0.333 .. 0.387 m and v in [22, 26) |y| <= 0.027 m:
+    // radius 0.333 .. 0.388 m, between the cylinder (0.3) and its band (0.4) with >= 10 mm
+    // margin both ways.
+    Raise(depth, 50, 54, 22, 26, 0.1);
+    // u = 60 and 61 are at x = 0.51 m, beyond the band: neither object nor outside.
+    Raise(depth, 60, 62, 22, 26, 0.1);
+    const SegmentedView view =
+        SegmentView(depth, cam, StationCalibration{}, LookingDown(), SmallVolume());
+    EXPECT_TRUE(view.points.empty());
+    EXPECT_EQ(view.outside_points, 4 * 4);
+    EXPECT_EQ(view.border_points, 0);
+}
+
+TEST(SegmentationConfig, ValidateNamesField) {
+    SegmentationConfig c;
+    c.max_height_m = c.min_height_m;
+    const Status s = c.Validate();
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.error().message.find("max_height_m"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace boxd
