@@ -19,7 +19,6 @@ namespace boxd {
 
 namespace {
 
-
 BoxDimensions Sorted(const BoxDimensions& d) {
     return {std::max(d.length_m, d.width_m), std::min(d.length_m, d.width_m), d.height_m};
 }
@@ -238,13 +237,13 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
     const double face_rms_limit =
         std::max(config.face_rms_ratio * sol->table_rms_m, config.face_rms_floor_m);
     if (sol->face_rms_m > face_rms_limit) {
-        return Error{ErrorCode::kNotConverged,
-                     fmt::format("no station geometry makes the views show a box of the stated "
-                                 "size: its faces fit to {:.1f} mm RMS (limit {:.1f} mm, table "
-                                 "{:.1f} mm); check the reference size, and that the box is rigid "
-                                 "and did not move",
-                                 sol->face_rms_m * 1e3, face_rms_limit * 1e3,
-                                 sol->table_rms_m * 1e3)};
+        return Error{
+            ErrorCode::kNotConverged,
+            fmt::format("no station geometry makes the views show a box of the stated "
+                        "size: its faces fit to {:.1f} mm RMS (limit {:.1f} mm, table "
+                        "{:.1f} mm); check the reference size, and that the box is rigid "
+                        "and did not move",
+                        sol->face_rms_m * 1e3, face_rms_limit * 1e3, sol->table_rms_m * 1e3)};
     }
 
     report.calibration = sol->calibration;

@@ -37,7 +37,8 @@ int RunCalibrate(const CalibrateOptions& opt) {
         }
         // Every refusal (too few poses, table not visible, wrong reference, box moved, no
         // convergence) is a problem with the input session: exit 2 with the code in the line.
-        return FailBadInput("calibrate: " + std::string(ErrorCodeName(report.error().code)) + ": " + report.error().message);
+        return FailBadInput("calibrate: " + std::string(ErrorCodeName(report.error().code)) + ": " +
+                            report.error().message);
     }
     if (!opt.out.empty()) {
         std::ofstream file(opt.out);

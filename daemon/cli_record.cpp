@@ -32,9 +32,7 @@ std::atomic<bool> g_cancel{false};
 
 void OnRecordStopSignal(int) { g_cancel.store(true); }
 
-bool IsInputError(const Error& e) {
-    return CategoryOf(e.code) == ErrorCategory::kBadInput;
-}
+bool IsInputError(const Error& e) { return CategoryOf(e.code) == ErrorCategory::kBadInput; }
 
 int RunRecord(const RecordOptions& options) {
     auto config = LoadStationConfig(options.config);

@@ -66,7 +66,8 @@ int RunSimTurntable(SimTurntableOptions o) {
                         ? simulator.ListenTcp(o.host, o.port)
                         : simulator.OpenRtu(o.rtu_device, o.baud, o.parity[0], 8, 1);
     if (!opened) {
-        if (opened.error().code == ErrorCode::kInvalidInput) return FailBadInput(opened.error().message);
+        if (opened.error().code == ErrorCode::kInvalidInput)
+            return FailBadInput(opened.error().message);
         spdlog::error("{}", opened.error().message);
         return kExitInternal;
     }

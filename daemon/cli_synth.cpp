@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "daemon/cli.h"
-#include "pipeline/session_io.h"
 #include "drivers/sim/synthetic_station.h"
+#include "pipeline/session_io.h"
 
 namespace boxd::cli {
 
@@ -46,7 +46,8 @@ Result<std::vector<fs::path>> PreviousSyntheticFrames(const fs::path& dir, bool 
     std::error_code ec;
     if (!fs::exists(dir, ec)) return std::vector<fs::path>{};
     if (!fs::is_directory(dir, ec)) {
-        return Error{ErrorCode::kInvalidInput, "--out " + dir.string() + ": exists and is not a folder"};
+        return Error{ErrorCode::kInvalidInput,
+                     "--out " + dir.string() + ": exists and is not a folder"};
     }
     if (fs::directory_iterator(dir, ec) == fs::directory_iterator()) {
         return std::vector<fs::path>{};
@@ -60,9 +61,10 @@ Result<std::vector<fs::path>> PreviousSyntheticFrames(const fs::path& dir, bool 
                            previous.value("format", "") == kSessionFormat;
     if (!synthetic) {
         if (force) return std::vector<fs::path>{};  // write over it, delete nothing
-        return Error{ErrorCode::kInvalidInput, "--out " + dir.string() +
-                                          ": folder is not empty and holds no synthetic session "
-                                          "(use --force to write into it anyway)"};
+        return Error{ErrorCode::kInvalidInput,
+                     "--out " + dir.string() +
+                         ": folder is not empty and holds no synthetic session "
+                         "(use --force to write into it anyway)"};
     }
     std::vector<fs::path> frames;
     if (previous.contains("poses") && previous["poses"].is_array()) {

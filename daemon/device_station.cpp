@@ -1,13 +1,12 @@
 #include "daemon/device_station.h"
 
-#include "pipeline/measure_pipeline.h"
-
 #include <spdlog/spdlog.h>
 
 #include <chrono>
 #include <fstream>
 
 #include "calibration/station_calibrator.h"
+#include "pipeline/measure_pipeline.h"
 #include "pipeline/ply_writer.h"
 #include "pipeline/session_io.h"
 
@@ -156,7 +155,8 @@ Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms
     capture_ms = MsSince(t_capture);
     if (!session) {
         const Error& e = session.error();
-        if (e.code == ErrorCode::kTurntableError || e.code == ErrorCode::kCameraError) MarkDeviceError(e);
+        if (e.code == ErrorCode::kTurntableError || e.code == ErrorCode::kCameraError)
+            MarkDeviceError(e);
     }
     return session;
 }
@@ -195,9 +195,8 @@ JobOutput DeviceStation::Measure(const JobContext& ctx) {
     std::vector<PreparedPose> prepared = preparer.Finish(*session);
     spdlog::info("measurement {}: {} of {} poses prepared during the capture", ctx.id,
                  prepared_during_capture, poses);
-    Result<MeasureOutput> measured = MeasurePrepared(*session, std::move(prepared),
-                                                     config_.measure, config_.method,
-                                                     SteadyClockMs());
+    Result<MeasureOutput> measured = MeasurePrepared(*session, std::move(prepared), config_.measure,
+                                                     config_.method, SteadyClockMs());
     if (!measured) {
         JobOutput failed = FailedOutput(measured.error().code, measured.error().message);
         failed.result.timing_ms["capture"] = capture_ms;
@@ -239,7 +238,8 @@ Result<json> DeviceStation::Calibrate(const JobContext& ctx, const BoxDimensions
     }
     std::error_code ec;
     std::filesystem::rename(tmp, config_.calibration_file, ec);
-    if (ec) return Error{ErrorCode::kStorageError, "cannot write " + config_.calibration_file.string()};
+    if (ec)
+        return Error{ErrorCode::kStorageError, "cannot write " + config_.calibration_file.string()};
 
     std::lock_guard lock(devices_mutex_);
     config_.station.calibration = report->calibration;

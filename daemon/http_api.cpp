@@ -27,9 +27,8 @@ constexpr int kCalibrationHistoryShown = 20;
 // Answers {"error": {"code", "message"}} with `http_status`, by default the code's.
 void SetError(Response& res, int http_status, ErrorCode code, const std::string& message) {
     res.status = http_status;
-    res.set_content(
-        json{{"error", {{"code", ErrorCodeName(code)}, {"message", message}}}}.dump(),
-        "application/json");
+    res.set_content(json{{"error", {{"code", ErrorCodeName(code)}, {"message", message}}}}.dump(),
+                    "application/json");
 }
 
 void SetError(Response& res, ErrorCode code, const std::string& message) {
@@ -357,8 +356,8 @@ Status HttpApi::Start() {
         }
         if (tcp_port_ <= 0) {
             tcp_port_ = 0;
-            return Error{ErrorCode::kBindFailed, "server.listen: cannot listen on " + config_.listen + ": " +
-                                            std::strerror(errno)};
+            return Error{ErrorCode::kBindFailed, "server.listen: cannot listen on " +
+                                                     config_.listen + ": " + std::strerror(errno)};
         }
         servers_.push_back(std::move(server));
     }
@@ -374,7 +373,8 @@ Status HttpApi::Start() {
         server->set_address_family(AF_UNIX);
         if (!server->bind_to_port(config_.unix_socket, 80)) {
             return Error{ErrorCode::kBindFailed, "server.unix_socket: cannot listen on " +
-                                            config_.unix_socket + ": " + std::strerror(errno)};
+                                                     config_.unix_socket + ": " +
+                                                     std::strerror(errno)};
         }
         servers_.push_back(std::move(server));
         unix_bound_ = true;

@@ -1,8 +1,9 @@
 // boxd: parcel dimensioner. Parses the command line and runs one subcommand.
+#include <spdlog/spdlog.h>
+
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
-#include <spdlog/spdlog.h>
 
 #include "daemon/cli.h"
 

@@ -33,7 +33,8 @@ void LogMeasurement(const MeasurementResult& r) {
                      r.id, StatusName(r.status), d.length_m, d.width_m, d.height_m, d.volume_m3,
                      d.method, r.quality.poses, timing);
     } else {
-        const std::string why = r.reason ? ErrorCodeName(r.reason->code) + std::string(": ") + r.reason->message : "-";
+        const std::string why =
+            r.reason ? ErrorCodeName(r.reason->code) + std::string(": ") + r.reason->message : "-";
         const auto level =
             r.status == MeasurementStatus::kFailed ? spdlog::level::err : spdlog::level::warn;
         spdlog::log(level, "measurement {} {}: {}, {} poses, {}", r.id, StatusName(r.status), why,
@@ -69,7 +70,8 @@ MeasurementService::MeasurementService(MeasurementStore& store, std::shared_ptr<
 }
 
 Result<std::vector<json>> MeasurementService::ListCalibrations(int limit) {
-    if (!history_) return Error{ErrorCode::kStorageError, "the calibration history is not available"};
+    if (!history_)
+        return Error{ErrorCode::kStorageError, "the calibration history is not available"};
     return history_->List(limit);
 }
 
@@ -129,7 +131,7 @@ Result<std::thread> MeasurementService::Claim(bool calibrating) {
     if (shutting_down_) return Error{ErrorCode::kShuttingDown, "the daemon is stopping"};
     if (running_) {
         return Error{ErrorCode::kBusy, calibrating_ ? std::string("a calibration is running")
-                                             : "measurement " + current_id_ + " is running"};
+                                                    : "measurement " + current_id_ + " is running"};
     }
     running_ = true;
     calibrating_ = calibrating;
@@ -213,12 +215,13 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
     r.timing_ms["total"] =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (cancel_ && r.status != MeasurementStatus::kOk) {
-        const std::string why =
-            r.reason ? " (" + std::string(ErrorCodeName(r.reason->code)) + ": " + r.reason->message + ")" : std::string();
+        const std::string why = r.reason ? " (" + std::string(ErrorCodeName(r.reason->code)) +
+                                               ": " + r.reason->message + ")"
+                                         : std::string();
         r.status = MeasurementStatus::kFailed;
         r.dimensions.reset();
-        r.reason =
-            MeasurementReason{ErrorCode::kAborted, "measurement aborted: the daemon is stopping" + why};
+        r.reason = MeasurementReason{ErrorCode::kAborted,
+                                     "measurement aborted: the daemon is stopping" + why};
     }
     const json result = ToJson(r);
     const Status saved = store_.Save(result, out.files);
@@ -320,7 +323,8 @@ void MeasurementService::RunCalibration(std::shared_ptr<CalibrationRun> run,
     if (result) {
         spdlog::info("calibration done: the new calibration is in force");
     } else {
-        spdlog::error("calibration failed: {}: {}", ErrorCodeName(result.error().code), result.error().message);
+        spdlog::error("calibration failed: {}: {}", ErrorCodeName(result.error().code),
+                      result.error().message);
     }
     RecordCalibration(run->reference, result);
     const bool station_ok = station->IsOpen();

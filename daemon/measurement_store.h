@@ -19,7 +19,6 @@ struct sqlite3;
 
 namespace boxd {
 
-
 // Files a finished measurement left in its scratch folder, moved into the store by Save().
 struct MeasurementFiles {
     std::optional<std::filesystem::path> cloud_ply;

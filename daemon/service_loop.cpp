@@ -40,7 +40,8 @@ std::string StatusLine(const ServiceSnapshot& s) {
             return "measuring " + s.measurement_id + ": " + s.progress.stage + " pose " +
                    std::to_string(s.progress.pose) + "/" + std::to_string(s.progress.poses);
         case ServiceState::kError:
-            return "error: " + (s.last_error ? ErrorCodeName(s.last_error->code) + std::string(": ") + s.last_error->message
+            return "error: " + (s.last_error ? ErrorCodeName(s.last_error->code) +
+                                                   std::string(": ") + s.last_error->message
                                              : std::string("devices not ready"));
         default:
             return std::string(ServiceStateName(s.state)) +

@@ -11,7 +11,8 @@ Error SqlError(sqlite3* db, const std::string& what) {
 Status SqlExec(sqlite3* db, const char* sql) {
     char* err = nullptr;
     if (sqlite3_exec(db, sql, nullptr, nullptr, &err) != SQLITE_OK) {
-        Error e{ErrorCode::kStorageError, std::string(sql).substr(0, 40) + "...: " + (err ? err : "?")};
+        Error e{ErrorCode::kStorageError,
+                std::string(sql).substr(0, 40) + "...: " + (err ? err : "?")};
         sqlite3_free(err);
         return e;
     }
@@ -47,7 +48,8 @@ Result<sqlite3*> OpenDatabase(const std::filesystem::path& data_dir,
         SqlStatement mode(db, "PRAGMA journal_mode;");
         wal = mode.prepared() && mode.Step() == SQLITE_ROW && mode.Text(0) == "wal";
     }
-    if (!wal) return fail(Error{ErrorCode::kStorageError, path.string() + ": cannot switch to WAL mode"});
+    if (!wal)
+        return fail(Error{ErrorCode::kStorageError, path.string() + ": cannot switch to WAL mode"});
     for (const char* sql : schema) {
         if (auto s = SqlExec(db, sql); !s) {
             return fail(Error{ErrorCode::kStorageError, path.string() + ": " + s.error().message});

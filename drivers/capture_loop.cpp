@@ -122,9 +122,9 @@ Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
     const auto timeout = std::chrono::milliseconds(config.grab_timeout_ms);
     auto cancelled = [&](int pose) -> Error {
         StopTable(turntable);
-        return Error{ErrorCode::kCancelled, "capture cancelled at pose " + std::to_string(pose + 1) +
-                                              " of " + std::to_string(n) +
-                                              "; the table was stopped"};
+        return Error{ErrorCode::kCancelled, "capture cancelled at pose " +
+                                                std::to_string(pose + 1) + " of " +
+                                                std::to_string(n) + "; the table was stopped"};
     };
 
     for (int k = 0; k < n; ++k) {
@@ -148,8 +148,8 @@ Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
             if (!frame) {
                 StopTable(turntable);
                 return Error{ErrorCode::kCameraError, "pose " + std::to_string(k + 1) + " of " +
-                                                   std::to_string(n) + ": " +
-                                                   frame.error().message};
+                                                          std::to_string(n) + ": " +
+                                                          frame.error().message};
             }
             if (frame->width != session.camera.width || frame->height != session.camera.height) {
                 StopTable(turntable);

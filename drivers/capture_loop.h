@@ -14,7 +14,6 @@
 
 namespace boxd {
 
-
 // The `capture:` section.
 struct CaptureConfig {
     int poses = 18;                  // evenly spaced over 360° (ignored when angles_deg is set)

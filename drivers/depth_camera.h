@@ -16,7 +16,6 @@
 
 namespace boxd {
 
-
 // Returns a CAMERA_ERROR carrying `message`.
 inline Error CameraError(std::string message) {
     return Error{ErrorCode::kCameraError, std::move(message)};

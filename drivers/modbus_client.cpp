@@ -123,9 +123,10 @@ Status ModbusClient::Transact(const std::string& what, Fn&& fn) {
                 last_error = std::string("Modbus exception: ") + modbus_strerror(err);
                 continue;
             }
-            return Error{ErrorCode::kTurntableError, Describe() + ": " + what +
-                                                  ": the drive answered with a Modbus exception: " +
-                                                  modbus_strerror(err)};
+            return Error{
+                ErrorCode::kTurntableError,
+                Describe() + ": " + what +
+                    ": the drive answered with a Modbus exception: " + modbus_strerror(err)};
         }
         // Transport failure: the connection may be dead or hold a late reply; start afresh.
         last_error = ErrnoText(err, config_.response_timeout_ms);

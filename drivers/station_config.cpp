@@ -270,7 +270,8 @@ Result<StationConfig> LoadStationConfig(const std::filesystem::path& path) {
                      path.string() + ": line " + std::to_string(e.mark.line + 1) + ": " + e.msg};
     }
     auto config = ParseStationConfig(root);
-    if (!config) return Error{ErrorCode::kInvalidInput, path.string() + ": " + config.error().message};
+    if (!config)
+        return Error{ErrorCode::kInvalidInput, path.string() + ": " + config.error().message};
     // A relative replay session path is relative to the config file, not the working folder.
     std::string& session = config->camera.replay.session;
     if (!session.empty() && std::filesystem::path(session).is_relative()) {

@@ -29,7 +29,6 @@ class Node;
 
 namespace boxd {
 
-
 // A snapshot of the drive, read in one go from its status registers.
 struct TurntableState {
     bool homed = false;

@@ -27,38 +27,38 @@ enum class ErrorCategory {
 };
 
 // X(enumerator, JSON name, category): the one list of codes.
-#define BOXD_ERROR_CODES(X)                                         \
-    X(kInvalidInput, "INVALID_INPUT", kBadInput)                    \
-    X(kInvalidConfig, "INVALID_CONFIG", kBadInput)                  \
-    X(kInvalidSession, "INVALID_SESSION", kBadInput)                \
-    X(kBadRequest, "BAD_REQUEST", kBadInput)                        \
-    X(kUnauthorized, "UNAUTHORIZED", kUnauthorized)                 \
-    X(kNotFound, "NOT_FOUND", kNotFound)                            \
-    X(kBusy, "BUSY", kConflict)                                     \
-    X(kPayloadTooLarge, "PAYLOAD_TOO_LARGE", kTooLarge)             \
-    X(kNoObject, "NO_OBJECT", kNoDimension)                         \
-    X(kObjectTooSmall, "OBJECT_TOO_SMALL", kNoDimension)            \
-    X(kObjectTooLarge, "OBJECT_TOO_LARGE", kNoDimension)            \
-    X(kRegistrationFailed, "REGISTRATION_FAILED", kNoDimension)     \
-    X(kObjectMoved, "OBJECT_MOVED", kNoDimension)                   \
-    X(kInsufficientData, "INSUFFICIENT_DATA", kNoDimension)         \
-    X(kNotCalibrated, "NOT_CALIBRATED", kNoDimension)               \
-    X(kTooFewPoses, "TOO_FEW_POSES", kCalibrationRefused)           \
-    X(kTableNotVisible, "TABLE_NOT_VISIBLE", kCalibrationRefused)   \
-    X(kNoReference, "NO_REFERENCE", kCalibrationRefused)            \
-    X(kWrongReference, "WRONG_REFERENCE", kCalibrationRefused)      \
-    X(kBoxMoved, "BOX_MOVED", kCalibrationRefused)                  \
-    X(kNotConverged, "NOT_CONVERGED", kCalibrationRefused)          \
-    X(kCameraError, "CAMERA_ERROR", kDevice)                        \
-    X(kTurntableError, "TURNTABLE_ERROR", kDevice)                  \
-    X(kCancelled, "CANCELLED", kInterrupted)                        \
-    X(kAborted, "ABORTED", kInterrupted)                            \
-    X(kShuttingDown, "SHUTTING_DOWN", kUnavailable)                 \
-    X(kTimeout, "TIMEOUT", kUnavailable)                            \
-    X(kLoopStalled, "LOOP_STALLED", kUnavailable)                   \
-    X(kStorageError, "STORAGE_ERROR", kStorage)                     \
-    X(kIoError, "IO_ERROR", kStorage)                               \
-    X(kBindFailed, "BIND_FAILED", kInternal)                        \
+#define BOXD_ERROR_CODES(X)                                       \
+    X(kInvalidInput, "INVALID_INPUT", kBadInput)                  \
+    X(kInvalidConfig, "INVALID_CONFIG", kBadInput)                \
+    X(kInvalidSession, "INVALID_SESSION", kBadInput)              \
+    X(kBadRequest, "BAD_REQUEST", kBadInput)                      \
+    X(kUnauthorized, "UNAUTHORIZED", kUnauthorized)               \
+    X(kNotFound, "NOT_FOUND", kNotFound)                          \
+    X(kBusy, "BUSY", kConflict)                                   \
+    X(kPayloadTooLarge, "PAYLOAD_TOO_LARGE", kTooLarge)           \
+    X(kNoObject, "NO_OBJECT", kNoDimension)                       \
+    X(kObjectTooSmall, "OBJECT_TOO_SMALL", kNoDimension)          \
+    X(kObjectTooLarge, "OBJECT_TOO_LARGE", kNoDimension)          \
+    X(kRegistrationFailed, "REGISTRATION_FAILED", kNoDimension)   \
+    X(kObjectMoved, "OBJECT_MOVED", kNoDimension)                 \
+    X(kInsufficientData, "INSUFFICIENT_DATA", kNoDimension)       \
+    X(kNotCalibrated, "NOT_CALIBRATED", kNoDimension)             \
+    X(kTooFewPoses, "TOO_FEW_POSES", kCalibrationRefused)         \
+    X(kTableNotVisible, "TABLE_NOT_VISIBLE", kCalibrationRefused) \
+    X(kNoReference, "NO_REFERENCE", kCalibrationRefused)          \
+    X(kWrongReference, "WRONG_REFERENCE", kCalibrationRefused)    \
+    X(kBoxMoved, "BOX_MOVED", kCalibrationRefused)                \
+    X(kNotConverged, "NOT_CONVERGED", kCalibrationRefused)        \
+    X(kCameraError, "CAMERA_ERROR", kDevice)                      \
+    X(kTurntableError, "TURNTABLE_ERROR", kDevice)                \
+    X(kCancelled, "CANCELLED", kInterrupted)                      \
+    X(kAborted, "ABORTED", kInterrupted)                          \
+    X(kShuttingDown, "SHUTTING_DOWN", kUnavailable)               \
+    X(kTimeout, "TIMEOUT", kUnavailable)                          \
+    X(kLoopStalled, "LOOP_STALLED", kUnavailable)                 \
+    X(kStorageError, "STORAGE_ERROR", kStorage)                   \
+    X(kIoError, "IO_ERROR", kStorage)                             \
+    X(kBindFailed, "BIND_FAILED", kInternal)                      \
     X(kInternal, "INTERNAL_ERROR", kInternal)
 
 enum class ErrorCode {

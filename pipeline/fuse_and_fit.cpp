@@ -11,8 +11,8 @@ FusedFit FuseAndFit(const std::vector<Points>& view_points, const std::vector<Se
     out.pca = FitPcaBox(out.fused.points);
     if (laps) laps->Lap("fit");
     if (out.box) {
-        out.consistency = CheckViewConsistency(out.fused, static_cast<int>(view_points.size()),
-                                               *out.box, fusion);
+        out.consistency =
+            CheckViewConsistency(out.fused, static_cast<int>(view_points.size()), *out.box, fusion);
     }
     return out;
 }

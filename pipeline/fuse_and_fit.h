@@ -13,10 +13,10 @@
 namespace boxd {
 
 struct FusedFit {
-    FusedCloud fused;                  // table frame of pose 0
-    Result<BoxFit> box = BoxFit{};     // the footprint box, or why the cloud supports none
-    OrientedBox pca;                   // the PCA box of the same cloud
-    ConsistencyReport consistency;     // per view, against `box` (empty when there is none)
+    FusedCloud fused;               // table frame of pose 0
+    Result<BoxFit> box = BoxFit{};  // the footprint box, or why the cloud supports none
+    OrientedBox pca;                // the PCA box of the same cloud
+    ConsistencyReport consistency;  // per view, against `box` (empty when there is none)
 };
 
 // Returns the fusion of `view_points` (per view, its own frame) moved by `poses`, and the fits.

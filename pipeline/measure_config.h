@@ -17,10 +17,10 @@ namespace boxd {
 // quality.confidence: the share of alignments kept, discounted by registration RMSE, face
 // noise and a thin cloud. A heuristic in [0, 1] for operators, not a probability.
 struct ConfidenceConfig {
-    double rmse_scale_m = 0.004;        // exp(-registration RMSE / this)
-    double face_sigma_scale_m = 0.01;   // exp(-face sigma / this)
-    long full_points = 20000;           // fewer fused points scale it down linearly
-    double single_view_share = 0.5;     // the "kept share" of a one-pose session
+    double rmse_scale_m = 0.004;       // exp(-registration RMSE / this)
+    double face_sigma_scale_m = 0.01;  // exp(-face sigma / this)
+    long full_points = 20000;          // fewer fused points scale it down linearly
+    double single_view_share = 0.5;    // the "kept share" of a one-pose session
 
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;

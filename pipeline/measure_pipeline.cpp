@@ -55,8 +55,8 @@ struct Measurement {
 double Confidence(const RegisteredViews& registered, int poses, const BoxFit& box, long points,
                   const ConfidenceConfig& c) {
     const EdgeStats& edges = registered.edges;
-    const double kept =
-        edges.attempted > 0 ? static_cast<double>(registered.graph.active_edges) / edges.attempted
+    const double kept = edges.attempted > 0
+                            ? static_cast<double>(registered.graph.active_edges) / edges.attempted
                             : (poses == 1 ? c.single_view_share : 0.0);
     return kept * std::exp(-edges.mean_rmse_m / c.rmse_scale_m) *
            std::exp(-box.face_sigma_m / c.face_sigma_scale_m) *

@@ -179,11 +179,13 @@ Status SolvePoseGraph(PoseGraph& graph, const PoseGraphConfig& config) {
     options.num_threads = 1;  // deterministic
     options.logging_type = ceres::SILENT;
     std::string why;
-    if (!options.IsValid(&why)) return Error{ErrorCode::kInternal, "pose graph solver options: " + why};
+    if (!options.IsValid(&why))
+        return Error{ErrorCode::kInternal, "pose graph solver options: " + why};
     ceres::Solver::Summary summary;
     ceres::Solve(options, p.problem.get(), &summary);
     if (!summary.IsSolutionUsable()) {
-        return Error{ErrorCode::kRegistrationFailed, "pose graph did not solve: " + summary.message};
+        return Error{ErrorCode::kRegistrationFailed,
+                     "pose graph did not solve: " + summary.message};
     }
     for (std::size_t k = 0; k < graph.poses.size(); ++k) {
         graph.poses[k] = Se2{p.params[k][0], p.params[k][1], Se2::WrapAngle(p.params[k][2])};

@@ -39,9 +39,10 @@ Result<std::vector<DepthMap>> UsableDepths(std::vector<PreparedPose> poses,
         depths[i] = std::move(poses[i].depth);
         const double valid = ValidFraction(depths[i]);
         if (valid < refuse.min_pose_valid_fraction) {
-            return Error{ErrorCode::kInsufficientData,
-                         fmt::format("pose {} has valid depth readings in only {:.1f}% of its pixels",
-                                     i, 100.0 * valid)};
+            return Error{
+                ErrorCode::kInsufficientData,
+                fmt::format("pose {} has valid depth readings in only {:.1f}% of its pixels", i,
+                            100.0 * valid)};
         }
     }
     return depths;

@@ -46,8 +46,9 @@ std::optional<MeasurementReason> CheckObjectViews(const ObjectViews& views,
     for (std::size_t k = 0; k < views.views.size(); ++k) {
         const SegmentedView& v = views.views[k];
         if (v.border_points > refuse.max_border_points) {
-            return MeasurementReason{ErrorCode::kObjectTooLarge,
-                                     fmt::format("the object is cut by the image border in pose {}", k)};
+            return MeasurementReason{
+                ErrorCode::kObjectTooLarge,
+                fmt::format("the object is cut by the image border in pose {}", k)};
         }
         if (v.outside_points > refuse.max_outside_points) {
             return MeasurementReason{
@@ -68,8 +69,9 @@ std::optional<MeasurementReason> CheckRegisteredViews(const RegisteredViews& reg
     const double yaw_deg = report.max_model_yaw_deviation_rad * 180.0 / M_PI;
     if (yaw_deg > refuse.max_model_yaw_deviation_deg ||
         report.max_model_translation_deviation_m > refuse.max_model_translation_deviation_m) {
-        return Moved(fmt::format("the views disagree with the turntable motion ({:.1f} deg, {:.1f} mm)",
-                                 yaw_deg, report.max_model_translation_deviation_m * 1000.0));
+        return Moved(
+            fmt::format("the views disagree with the turntable motion ({:.1f} deg, {:.1f} mm)",
+                        yaw_deg, report.max_model_translation_deviation_m * 1000.0));
     }
     const int edges = report.rejected_edges + report.active_edges;
     if (edges > 0 && report.rejected_edges > refuse.max_rejected_edge_fraction * edges) {
@@ -104,8 +106,9 @@ std::optional<MeasurementReason> CheckFusedFit(const FusedFit& fit, const Refusa
     }
     const ConsistencyReport& c = fit.consistency;
     if (!c.inconsistent_views.empty()) {
-        return Moved(fmt::format("view {} disagrees with the others ({:.0f}% of its points on the box)",
-                                 c.worst_view, 100.0 * c.worst_inlier_fraction));
+        return Moved(
+            fmt::format("view {} disagrees with the others ({:.0f}% of its points on the box)",
+                        c.worst_view, 100.0 * c.worst_inlier_fraction));
     }
     if (box.face_sigma_m > refuse.max_face_sigma_m) {
         return MeasurementReason{

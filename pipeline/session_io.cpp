@@ -312,7 +312,8 @@ Result<Session> LoadSession(const fs::path& dir) {
 Status WriteSession(const Session& session, const fs::path& dir) {
     std::error_code ec;
     fs::create_directories(dir, ec);
-    if (ec) return Error{ErrorCode::kIoError, dir.string() + ": cannot create folder: " + ec.message()};
+    if (ec)
+        return Error{ErrorCode::kIoError, dir.string() + ": cannot create folder: " + ec.message()};
 
     json poses = json::array();
     std::vector<std::pair<fs::path, const DepthImage*>> pngs;
@@ -323,7 +324,8 @@ Status WriteSession(const Session& session, const fs::path& dir) {
             const std::string rel =
                 k < p.frame_paths.size() ? p.frame_paths[k] : SessionFramePath(i, k);
             if (!IsContainedRelativePath(rel)) {
-                return Error{ErrorCode::kInvalidInput, "frame path '" + rel + "' leaves the session folder"};
+                return Error{ErrorCode::kInvalidInput,
+                             "frame path '" + rel + "' leaves the session folder"};
             }
             const fs::path file = dir / rel;
             fs::create_directories(file.parent_path(), ec);

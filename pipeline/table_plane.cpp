@@ -86,8 +86,9 @@ Result<TablePlaneFit> FitTablePlane(const std::vector<DepthMap>& depths,
         }
     }
     if (static_cast<int>(pts.size()) < config.min_points) {
-        return Error{ErrorCode::kInsufficientData, "too few table-top readings to locate the table (" +
-                                              std::to_string(pts.size()) + ")"};
+        return Error{
+            ErrorCode::kInsufficientData,
+            "too few table-top readings to locate the table (" + std::to_string(pts.size()) + ")"};
     }
     // Iteratively trimmed least squares: box faces and bumps near the table top are a minority
     // and fall outside the shrinking band.

@@ -45,8 +45,13 @@ Result<std::unique_ptr<SimTurntableProcess>> SimTurntableProcess::Start(
     // Everything the child needs is prepared before fork: it only redirects and execs.
     std::vector<std::string> args = {
         launch.binary.empty() ? CurrentExecutable().string() : launch.binary.string(),
-        "sim-turntable", "--host", "127.0.0.1", "--port", std::to_string(launch.port),
-        "--port-file", port_file.string()};
+        "sim-turntable",
+        "--host",
+        "127.0.0.1",
+        "--port",
+        std::to_string(launch.port),
+        "--port-file",
+        port_file.string()};
     args.insert(args.end(), launch.args.begin(), launch.args.end());
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());

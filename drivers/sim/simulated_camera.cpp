@@ -25,7 +25,8 @@ constexpr double kSamePoseDeg = 0.05;
 
 Status SimulatedCameraConfig::Validate() const {
     if (frame_interval_ms < 0 || frame_interval_ms > 10'000) {
-        return Error{ErrorCode::kInvalidInput, "camera.simulated.frame_interval_ms: must be 0..10000"};
+        return Error{ErrorCode::kInvalidInput,
+                     "camera.simulated.frame_interval_ms: must be 0..10000"};
     }
     if (auto st = station.Validate(); !st) {
         std::string message = st.error().message;

@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <optional>
 
-#include "pipeline/result.h"
 #include "drivers/sim/sensor_noise.h"
+#include "pipeline/result.h"
 #include "pipeline/session.h"
 
 namespace boxd {

@@ -239,7 +239,8 @@ struct TurntableSimulator::Impl {
         const int n = select(max_fd + 1, &readable, nullptr, nullptr, &timeout);
         if (n < 0) {
             if (errno == EINTR) return OkStatus();
-            return Error{ErrorCode::kInternal, std::string("sim-turntable: select: ") + strerror(errno)};
+            return Error{ErrorCode::kInternal,
+                         std::string("sim-turntable: select: ") + strerror(errno)};
         }
         Publish();
         if (n == 0) return OkStatus();
@@ -284,7 +285,8 @@ struct TurntableSimulator::Impl {
         const int n = select(fd + 1, &readable, nullptr, nullptr, &timeout);
         if (n < 0) {
             if (errno == EINTR) return OkStatus();
-            return Error{ErrorCode::kInternal, std::string("sim-turntable: select: ") + strerror(errno)};
+            return Error{ErrorCode::kInternal,
+                         std::string("sim-turntable: select: ") + strerror(errno)};
         }
         Publish();
         if (n == 0) return OkStatus();
@@ -319,7 +321,8 @@ TurntableSimulator::~TurntableSimulator() {
 
 Status TurntableSimulator::ListenTcp(const std::string& host, int port) {
     if (auto st = impl_->config.Validate(); !st) return st;
-    if (!impl_->map) return Error{ErrorCode::kInternal, "sim-turntable: cannot allocate the registers"};
+    if (!impl_->map)
+        return Error{ErrorCode::kInternal, "sim-turntable: cannot allocate the registers"};
     impl_->ctx = modbus_new_tcp(host.c_str(), port);
     if (!impl_->ctx) {
         return SimError("sim-turntable: bad listen address " + host + ":" + std::to_string(port));
@@ -327,7 +330,8 @@ Status TurntableSimulator::ListenTcp(const std::string& host, int port) {
     impl_->listen_fd = modbus_tcp_listen(impl_->ctx, 8);
     if (impl_->listen_fd < 0) {
         return Error{ErrorCode::kInternal, "sim-turntable: cannot listen on " + host + ":" +
-                                     std::to_string(port) + ": " + modbus_strerror(errno)};
+                                               std::to_string(port) + ": " +
+                                               modbus_strerror(errno)};
     }
     sockaddr_in bound{};
     socklen_t len = sizeof(bound);
@@ -342,7 +346,8 @@ int TurntableSimulator::port() const { return impl_->port; }
 Status TurntableSimulator::OpenRtu(const std::string& device, int baud, char parity, int data_bits,
                                    int stop_bits) {
     if (auto st = impl_->config.Validate(); !st) return st;
-    if (!impl_->map) return Error{ErrorCode::kInternal, "sim-turntable: cannot allocate the registers"};
+    if (!impl_->map)
+        return Error{ErrorCode::kInternal, "sim-turntable: cannot allocate the registers"};
     impl_->rtu = true;
     impl_->ctx = modbus_new_rtu(device.c_str(), baud, parity, data_bits, stop_bits);
     if (!impl_->ctx) {

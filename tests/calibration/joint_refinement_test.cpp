@@ -15,7 +15,7 @@ constexpr int kPixelStride = 6;  // ~9 mm between samples at 0.9 m: ~1000 box po
 
 // Error codes are compared as strings only here (they will become an enum).
 template <typename T>
-void ExpectError(const Result<T>& r, const char* code) {
+void ExpectError(const Result<T>& r, ErrorCode code) {
     ASSERT_FALSE(r.ok());
     EXPECT_EQ(r.error().code, code);
 }
@@ -151,7 +151,7 @@ TEST(RefineJointly, NoBoxInViewDoesNotConverge) {
     std::vector<CalibrationView> views;
     for (int k = 0; k < kPoses; ++k) views.push_back(CastView(cam, k, /*no_box=*/true));
     ExpectError(RefineJointly(views, cam, kReference, Perturbed(), JointRefinementConfig{}),
-                "NOT_CONVERGED");
+                ErrorCode::kNotConverged);
 }
 
 TEST(JointCameraToTable, AppliesTiltAndCentreToTheBase) {

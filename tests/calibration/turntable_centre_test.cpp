@@ -11,7 +11,7 @@ constexpr double kDeg = M_PI / 180.0;
 
 // Error codes are compared as strings only here (they will become an enum).
 template <typename T>
-void ExpectError(const Result<T>& r, const char* code) {
+void ExpectError(const Result<T>& r, ErrorCode code) {
     ASSERT_FALSE(r.ok());
     EXPECT_EQ(r.error().code, code);
 }
@@ -59,7 +59,7 @@ TEST(FitTurntableCentre, RmsIsTheDisagreementOfTheMotions) {
 TEST(FitTurntableCentre, NoRotationIsAnError) {
     ExpectError(
         FitTurntableCentre({Se2{}, Se2{0.001, 0.0, 0.9 * kDeg}, Se2{0.0, 0.0, -0.9 * kDeg}}),
-        "INSUFFICIENT_DATA");
+        ErrorCode::kInsufficientData);
 }
 
 }  // namespace

@@ -63,7 +63,8 @@ public:
         while (hold && !ctx.cancelled()) std::this_thread::sleep_for(2ms);
         in_capture = false;
         if (ctx.cancelled()) return Error{ErrorCode::kCancelled, "capture cancelled"};
-        if (reference.height_m > 1.0) return Error{ErrorCode::kWrongReference, "measured 0.2 m high"};
+        if (reference.height_m > 1.0)
+            return Error{ErrorCode::kWrongReference, "measured 0.2 m high"};
         return json{{"calibration", {{"depth_scale", 1.0}}}, {"reference_h", reference.height_m}};
     }
     void RequestStop() override { ++stop_requests; }

@@ -11,8 +11,8 @@
 
 #include "drivers/modbus_client.h"
 #include "drivers/sim/simulated_camera.h"
-#include "drivers/turntable.h"
 #include "drivers/sim/turntable_simulator.h"
+#include "drivers/turntable.h"
 
 namespace boxd {
 namespace {

@@ -13,9 +13,9 @@
 #include <sstream>
 #include <thread>
 
+#include "drivers/sim/synthetic_station.h"
 #include "drivers/station_config.h"
 #include "pipeline/session_io.h"
-#include "drivers/sim/synthetic_station.h"
 #include "tests/support/child_process.h"
 #include "tests/support/run_command.h"
 #include "tests/support/temp_dir.h"

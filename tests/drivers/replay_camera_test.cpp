@@ -9,9 +9,9 @@
 #include "drivers/capture_loop.h"
 #include "drivers/driver_registry.h"
 #include "drivers/replay_turntable.h"
+#include "drivers/sim/synthetic_station.h"
 #include "drivers/station_config.h"
 #include "pipeline/session_io.h"
-#include "drivers/sim/synthetic_station.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd {

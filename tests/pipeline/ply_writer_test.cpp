@@ -13,7 +13,7 @@ namespace boxd {
 namespace {
 
 // Error codes are compared as strings only here (they will become an enum).
-void ExpectError(const Status& s, const char* code) {
+void ExpectError(const Status& s, ErrorCode code) {
     ASSERT_FALSE(s.ok());
     EXPECT_EQ(s.error().code, code);
 }
@@ -51,7 +51,7 @@ TEST(WritePly, EmptyCloudHasZeroVertices) {
 
 TEST(WritePly, UnwritablePathIsAnIoError) {
     test::TempDir dir;
-    ExpectError(WritePly(dir / "missing" / "cloud.ply", {{0.0f, 0.0f, 0.0f}}), "IO_ERROR");
+    ExpectError(WritePly(dir / "missing" / "cloud.ply", {{0.0f, 0.0f, 0.0f}}), ErrorCode::kIoError);
 }
 
 }  // namespace

@@ -91,8 +91,7 @@ TEST(CheckRegisteredViews, MovedObjectUnregisteredViewsAndPoorAlignment) {
     EXPECT_EQ(CheckRegisteredViews(Registered(0, 0, 0.0), 18, refuse)->code,
               ErrorCode::kRegistrationFailed);
 
-    why = CheckRegisteredViews(Registered(36, 0, refuse.max_registration_rmse_m * 1.5), 18,
-                               refuse);
+    why = CheckRegisteredViews(Registered(36, 0, refuse.max_registration_rmse_m * 1.5), 18, refuse);
     ASSERT_TRUE(why.has_value());
     EXPECT_EQ(why->code, ErrorCode::kRegistrationFailed);
     EXPECT_NE(why->message.find("RMSE 6.0 mm"), std::string::npos) << why->message;

@@ -13,7 +13,7 @@ constexpr double kDeg = M_PI / 180.0;
 
 // Error codes are compared as strings only here (they will become an enum).
 template <typename T>
-void ExpectError(const Result<T>& r, const char* code) {
+void ExpectError(const Result<T>& r, ErrorCode code) {
     ASSERT_FALSE(r.ok());
     EXPECT_EQ(r.error().code, code);
 }
@@ -170,7 +170,8 @@ TEST(FitTablePlane, TooFewTablePointsIsAnError) {
     // A 0.03 m disc covers ~800 pixels (1.6 x 2.2 mm each at 0.9 m and 45 degrees); the stride
     // of 3 in each direction leaves ~90, far below the 300 needed.
     const std::vector<DepthMap> depths = {Render(cam, recorded.CameraToTable(), nullptr, 0.03)};
-    ExpectError(FitTablePlane(depths, cam, recorded, TablePlaneConfig{}), "INSUFFICIENT_DATA");
+    ExpectError(FitTablePlane(depths, cam, recorded, TablePlaneConfig{}),
+                ErrorCode::kInsufficientData);
 }
 
 TEST(FitTablePlane, CorrectionBeyondMaxTiltIsAnError) {
@@ -182,7 +183,7 @@ TEST(FitTablePlane, CorrectionBeyondMaxTiltIsAnError) {
     TablePlaneConfig config;
     config.search_band_m = 0.06;  // 4 degrees over the 0.34 m disc reach 24 mm: keep them all
     config.max_tilt_deg = 3.0;
-    ExpectError(FitTablePlane(depths, cam, recorded, config), "REGISTRATION_FAILED");
+    ExpectError(FitTablePlane(depths, cam, recorded, config), ErrorCode::kRegistrationFailed);
     // The same data pass once the limit allows 4 degrees: the limit is what refused them.
     config.max_tilt_deg = 5.0;
     auto fit = FitTablePlane(depths, cam, recorded, config);

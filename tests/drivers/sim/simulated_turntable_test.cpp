@@ -6,8 +6,8 @@
 #include <thread>
 
 #include "drivers/sim/simulated_drive.h"
-#include "drivers/turntable.h"
 #include "drivers/sim/turntable_simulator.h"
+#include "drivers/turntable.h"
 #include "tests/drivers/sim_turntable_process.h"
 
 namespace boxd {
