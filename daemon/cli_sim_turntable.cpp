@@ -1,12 +1,15 @@
 // `boxd sim-turntable`: a simulated Modbus turntable drive (SPEC section 8) on TCP or RTU.
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <atomic>
+#include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <thread>
 
 #include "daemon/cli.h"
 #include "drivers/sim/turntable_simulator.h"
@@ -28,6 +31,7 @@ struct SimTurntableOptions {
     std::string parity = "N";
     std::string fault = "none";
     std::string port_file;
+    bool exit_with_parent = false;
     TurntableSimulatorConfig sim;
 };
 
@@ -79,7 +83,21 @@ int RunSimTurntable(SimTurntableOptions o) {
                  o.sim.max_speed_dps, o.sim.settle_ms, SimulatedFaultName(o.sim.fault),
                  o.sim.fault_after_moves);
 
+    // A launched simulator stops when the process that started it is gone, however it ended
+    // (kill -9 included): it is then re-parented, and getppid() changes.
+    std::thread parent_watch;
+    std::atomic<bool> served_out{false};
+    if (o.exit_with_parent) {
+        parent_watch = std::thread([parent = getppid(), &served_out] {
+            while (!served_out.load() && getppid() == parent) {
+                std::this_thread::sleep_for(std::chrono::milliseconds(50));
+            }
+            g_stop_requested.store(true);
+        });
+    }
     auto served = simulator.Serve(g_stop_requested);
+    served_out.store(true);
+    if (parent_watch.joinable()) parent_watch.join();
     if (!served) {
         spdlog::error("{}", served.error().message);
         return kExitInternal;
@@ -97,6 +115,8 @@ void AddSimTurntable(CLI::App& app, Runner& run) {
         "flags or the special registers 100..108, see README)");
     sub->add_option("--port", opts->port, "Modbus TCP port to listen on (0 picks a free one)");
     sub->add_option("--host", opts->host, "address to listen on")->capture_default_str();
+    sub->add_flag("--exit-with-parent", opts->exit_with_parent,
+                  "stop serving when the process that started this one exits");
     sub->add_option("--rtu", opts->rtu_device, "serve Modbus RTU on this serial device instead");
     sub->add_option("--baud", opts->baud, "RTU baud rate")->capture_default_str();
     sub->add_option("--parity", opts->parity, "RTU parity: N, E or O")->capture_default_str();

@@ -46,6 +46,8 @@ void LogMeasurement(const MeasurementResult& r) {
 
 const char* ServiceStateName(ServiceState s) {
     switch (s) {
+        case ServiceState::kStarting:
+            return "starting";
         case ServiceState::kIdle:
             return "idle";
         case ServiceState::kMeasuring:
@@ -100,6 +102,7 @@ Status MeasurementService::OpenStation() {
     {
         std::lock_guard lock(mutex_);
         station_ok_ = s.ok();
+        station_opened_ = true;
         if (!s) {
             last_error_ = s.error();
             last_error_at_ = UtcTimestampNow();
@@ -121,6 +124,7 @@ Status MeasurementService::ReplaceStation(std::shared_ptr<Station> station, bool
         station_ = std::move(station);
         keep_sessions_ = keep_sessions;
         station_ok_ = false;
+        station_opened_ = false;
     }
     Notify();
     return OkStatus();
@@ -388,8 +392,10 @@ bool MeasurementService::Busy() const {
 ServiceSnapshot MeasurementService::Snapshot() const {
     std::lock_guard lock(mutex_);
     ServiceSnapshot s;
-    s.state = running_ ? (calibrating_ ? ServiceState::kCalibrating : ServiceState::kMeasuring)
-                       : (station_ok_ ? ServiceState::kIdle : ServiceState::kError);
+    s.state = running_      ? (calibrating_ ? ServiceState::kCalibrating : ServiceState::kMeasuring)
+              : station_ok_ ? ServiceState::kIdle
+              : station_opened_ ? ServiceState::kError
+                                : ServiceState::kStarting;  // the devices are still coming up
     s.measurement_id = current_id_;
     s.progress = progress_;
     s.last_error = last_error_;

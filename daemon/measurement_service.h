@@ -21,9 +21,9 @@
 
 namespace boxd {
 
-enum class ServiceState { kIdle, kMeasuring, kCalibrating, kError };
+enum class ServiceState { kStarting, kIdle, kMeasuring, kCalibrating, kError };
 
-// Returns "idle" / "measuring" / "calibrating" / "error".
+// Returns "starting" / "idle" / "measuring" / "calibrating" / "error".
 const char* ServiceStateName(ServiceState s);
 
 // Error codes of the service (besides the station's and the store's).
@@ -100,6 +100,7 @@ private:
     std::shared_ptr<Station> station_;
     bool keep_sessions_ = false;
     bool station_ok_ = false;
+    bool station_opened_ = false;  // OpenStation() has run on the station in force
     bool running_ = false;
     bool calibrating_ = false;
     bool shutting_down_ = false;

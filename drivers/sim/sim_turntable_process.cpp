@@ -4,7 +4,6 @@
 #include <signal.h>
 #include <spdlog/spdlog.h>
 #include <stdlib.h>
-#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -51,7 +50,8 @@ Result<std::unique_ptr<SimTurntableProcess>> SimTurntableProcess::Start(
         "--port",
         std::to_string(launch.port),
         "--port-file",
-        port_file.string()};
+        port_file.string(),
+        "--exit-with-parent"};
     args.insert(args.end(), launch.args.begin(), launch.args.end());
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
@@ -64,8 +64,9 @@ Result<std::unique_ptr<SimTurntableProcess>> SimTurntableProcess::Start(
     const pid_t parent = getpid();
     const pid_t pid = fork();
     if (pid == 0) {
-        // The child must not outlive its parent, even when the parent is killed with SIGKILL.
-        prctl(PR_SET_PDEATHSIG, SIGTERM);
+        // The child must not outlive this process, even when it is killed with SIGKILL:
+        // --exit-with-parent makes it watch its parent. (PR_SET_PDEATHSIG would fire when the
+        // forking *thread* ends, and devices are opened from worker threads.)
         if (getppid() != parent) _exit(1);
         if (null_fd >= 0) {
             dup2(null_fd, 0);

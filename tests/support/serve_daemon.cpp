@@ -31,7 +31,11 @@ ServeDaemon::~ServeDaemon() { process_.Terminate(std::chrono::seconds(20)); }
 bool ServeDaemon::WaitHealthy(std::chrono::seconds timeout) {
     const auto deadline = Clock::now() + timeout;
     while (Clock::now() < deadline) {
-        if (auto res = client_.Get("/v1/health"); res && res->status == 200) return true;
+        // Health answers while the devices are still coming up ("starting"): ready is past that.
+        if (auto res = client_.Get("/v1/health"); res && res->status == 200) {
+            const nlohmann::json status = GetJson("/v1/status");
+            if (status.value("state", "") != "starting") return true;
+        }
         if (!process_.Running()) return false;
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }

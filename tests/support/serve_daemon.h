@@ -32,8 +32,8 @@ public:
     httplib::Client& client() { return client_; }
     ChildProcess& process() { return process_; }
     int port() const { return port_; }
-    // Returns true once GET /v1/health answers 200 (the daemon has opened its devices and
-    // announced readiness by then); false when it exits or `timeout` passes first.
+    // Returns true once GET /v1/health answers 200 and /v1/status has left "starting" (the
+    // daemon has tried its devices); false when it exits or `timeout` passes first.
     bool WaitHealthy(std::chrono::seconds timeout = std::chrono::seconds(60));
     // Returns the JSON body of GET `path`, or {"transport_error": ...}.
     nlohmann::json GetJson(const std::string& path);
