@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "daemon/cli.h"
+#include "drivers/sim/synthetic_objects.h"
 #include "drivers/sim/synthetic_station.h"
 #include "pipeline/session_io.h"
 
@@ -37,6 +38,13 @@ struct SynthOptions {
     std::optional<double> depth_offset_m, calib_depth_offset_error_m;
     std::optional<int> move_at_pose;
     std::vector<double> move_by;
+    std::vector<double> angles;
+    // The object and its real-parcel features (SyntheticBox).
+    std::string shape = "box";
+    double edge_radius_m = 0.0, bulge_m = 0.0, bulge_top_m = 0.0;
+    double strap_m = 0.0, strap_width_m = 0.025, label_m = 0.0, flap_deg = 0.0;
+    std::vector<double> second_dims, second_offset;
+    std::optional<int> intruder_pose;
     bool force = false;
 };
 
@@ -111,6 +119,29 @@ Result<SyntheticStationConfig> MakeConfig(const SynthOptions& o) {
         c.box.offset_y_m = o.offset.at(1);
     }
     c.box.yaw_deg = o.yaw_deg;
+    auto shape = ParseSyntheticShape(o.shape);
+    if (!shape) return Error{ErrorCode::kInvalidInput, "--" + shape.error().message};
+    c.box.shape = *shape;
+    c.box.edge_radius_m = o.edge_radius_m;
+    c.box.bulge_m = o.bulge_m;
+    c.box.bulge_top_m = o.bulge_top_m;
+    c.box.strap_thickness_m = o.strap_m;
+    c.box.strap_width_m = o.strap_width_m;
+    c.box.label_thickness_m = o.label_m;
+    c.box.flap_deg = o.flap_deg;
+    if (!o.second_dims.empty()) {
+        SyntheticBox second;
+        second.length_m = o.second_dims.at(0);
+        second.width_m = o.second_dims.at(1);
+        second.height_m = o.second_dims.at(2);
+        if (o.second_offset.empty()) {
+            return Error{ErrorCode::kInvalidInput, "--second-dims needs --second-offset"};
+        }
+        second.offset_x_m = o.second_offset.at(0);
+        second.offset_y_m = o.second_offset.at(1);
+        c.extra_objects.push_back(second);
+    }
+    c.intruder_pose = o.intruder_pose;
     if (o.distance_m) c.camera_pose.distance_m = *o.distance_m;
     if (o.elevation_deg) c.camera_pose.elevation_deg = *o.elevation_deg;
     if (o.aim_height_m) c.camera_pose.aim_height_m = *o.aim_height_m;
@@ -144,7 +175,8 @@ int RunSynth(const SynthOptions& o) {
     auto previous = PreviousSyntheticFrames(o.out, o.force);
     if (!previous) return FailBadInput(previous.error().message);
 
-    auto session = RenderSyntheticSession(*config, o.poses, o.frames);
+    auto session = o.angles.empty() ? RenderSyntheticSession(*config, o.poses, o.frames)
+                                    : RenderSyntheticSession(*config, o.angles, o.frames);
     if (!session) return FailBadInput(session.error().message);
     const auto rendered = std::chrono::steady_clock::now();
     spdlog::info("synth: rendered {} poses x {} frames ({} noise, seed {})", o.poses, o.frames,
@@ -161,18 +193,19 @@ int RunSynth(const SynthOptions& o) {
     };
     std::error_code ec;
     const fs::path abs = fs::absolute(o.out, ec);
-    const BoxDimensions& gt = *session->ground_truth;
-    const json summary = {
-        {"path", (ec ? o.out : abs).lexically_normal().string()},
-        {"poses", o.poses},
-        {"frames", o.frames},
-        {"noise", NoiseModelName(config->noise)},
-        {"seed", o.seed},
-        {"ground_truth",
-         {{"length_m", gt.length_m}, {"width_m", gt.width_m}, {"height_m", gt.height_m}}},
-        {"elapsed_ms", ms(end - start)},
-        {"render_ms", ms(rendered - start)},
-        {"write_ms", ms(end - rendered)}};
+    json truth = nullptr;  // two objects have no single size
+    if (const auto& gt = session->ground_truth) {
+        truth = {{"length_m", gt->length_m}, {"width_m", gt->width_m}, {"height_m", gt->height_m}};
+    }
+    const json summary = {{"path", (ec ? o.out : abs).lexically_normal().string()},
+                          {"poses", session->poses.size()},
+                          {"frames", o.frames},
+                          {"noise", NoiseModelName(config->noise)},
+                          {"seed", o.seed},
+                          {"ground_truth", truth},
+                          {"elapsed_ms", ms(end - start)},
+                          {"render_ms", ms(rendered - start)},
+                          {"write_ms", ms(end - rendered)}};
     std::printf("%s\n", summary.dump().c_str());
     return kExitOk;
 }
@@ -207,6 +240,24 @@ void AddSynth(CLI::App& app, Runner& run) {
                     "sensor bias plus this; minus the bias records 0 (depth never calibrated)");
     sub->add_option("--move-at-pose", o->move_at_pose, "The box is moved from this pose on");
     sub->add_option("--move-by", o->move_by, "The move: DX DY (m) DYAW (deg)")->expected(3);
+    sub->add_option("--angles", o->angles,
+                    "Commanded pose angles (deg, any spacing); replaces --poses")
+        ->delimiter(',');
+    sub->add_option("--shape", o->shape, "box, cylinder, lying_cylinder, l_shape or bag")
+        ->capture_default_str();
+    sub->add_option("--edge-radius", o->edge_radius_m, "Rounded edges: radius (m)");
+    sub->add_option("--bulge", o->bulge_m, "Side faces bulge out by this much (m)");
+    sub->add_option("--bulge-top", o->bulge_top_m, "The top bulges out by this much (m)");
+    sub->add_option("--strap", o->strap_m, "A strap over the top and both ends: thickness (m)");
+    sub->add_option("--strap-width", o->strap_width_m, "The strap's width (m)")
+        ->capture_default_str();
+    sub->add_option("--label", o->label_m, "A label on a side face: thickness (m)");
+    sub->add_option("--flap-deg", o->flap_deg, "A top flap opened by this angle (deg)");
+    sub->add_option("--second-dims", o->second_dims, "A second box: length, width, height (m)")
+        ->expected(3);
+    sub->add_option("--second-offset", o->second_offset, "The second box's centre X Y (m)")
+        ->expected(2);
+    sub->add_option("--intruder-pose", o->intruder_pose, "A hand reaches in at this pose");
     sub->add_flag("--force", o->force, "Write into a non-empty folder that holds no session");
     sub->callback([&run, o] { run = [o] { return RunSynth(*o); }; });
 }

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <limits>
 
+#include "drivers/sim/synthetic_objects.h"
+
 namespace boxd {
 
 namespace {
@@ -95,6 +97,10 @@ SyntheticRayCaster::SyntheticRayCaster(const SyntheticStationConfig& config, dou
     box_radius_sq_ = box_half_.squaredNorm() * (1.0 + 1e-9);
     inv_fx_ = 1.0 / camera_.fx;
     inv_fy_ = 1.0 / camera_.fy;
+    ideal_box_ = config.box.IsIdealBox();
+    if (auto mesh = PlacedObjectMeshes(config, table_angle_rad, pose_index)) {
+        meshes_ = std::make_shared<const MeshRayCaster>(*mesh);
+    }
 }
 
 SyntheticRayHit SyntheticRayCaster::Cast(double u, double v) const {
@@ -116,10 +122,16 @@ SyntheticRayHit SyntheticRayCaster::Cast(double u, double v) const {
     const double lo[3] = {-box_half_.x(), -box_half_.y(), 0.0};
     const double hi[3] = {box_half_.x(), box_half_.y(), 2.0 * box_half_.z()};
     double component = 0.0;
-    const double t_box = IntersectBox(ob, db, lo, hi, component);
+    const double t_box = ideal_box_ ? IntersectBox(ob, db, lo, hi, component) : kInf;
     if (t_box < best_t) {
         best_t = t_box;
         best_component = component;
+    }
+    // Mesh objects. The ray parameter is the z-depth here too: `d` is not normalised.
+    MeshRayCaster::Hit mesh_hit;
+    if (meshes_ && meshes_->Intersect(origin_, d, best_t, mesh_hit) && mesh_hit.t < best_t) {
+        best_t = mesh_hit.t;
+        best_component = mesh_hit.cos_incidence * d_norm;
     }
 
     if (d.z() < 0.0) {

@@ -1,9 +1,12 @@
 #pragma once
 // The synthetic station's geometry: where the camera sits in the table frame, where the box
-// stands at a table angle, and exact ray casting of box, disc (top and rim) and floor.
+// stands at a table angle, and ray casting of the scene: the ideal box, disc (top and rim) and
+// floor exactly, every other object as a triangle mesh (MeshRayCaster).
 
 #include <Eigen/Core>
+#include <memory>
 
+#include "drivers/sim/mesh_ray_caster.h"
 #include "drivers/sim/synthetic_station.h"
 
 namespace boxd {
@@ -56,6 +59,8 @@ private:
     double box_radius_sq_ = 0.0;            // squared radius of the box's bounding sphere
     Eigen::Vector3d box_half_;              // half extents; box frame z runs 0..height
     double disc_radius_ = 0.0, disc_thickness_ = 0.0, floor_drop_ = 0.0;
+    bool ideal_box_ = true;                        // the main object is the exact box above
+    std::shared_ptr<const MeshRayCaster> meshes_;  // every other object, table frame (or null)
 };
 
 }  // namespace boxd

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "drivers/sim/synthetic_geometry.h"
+#include "drivers/sim/synthetic_objects.h"
 #include "drivers/sim/synthetic_random.h"
 
 namespace boxd {
@@ -41,20 +42,6 @@ Error Bad(const std::string& field, const std::string& why) {
 }
 
 bool Finite(double x) { return std::isfinite(x); }
-
-// Returns how far the box footprint reaches from the axis with its centre at (x, y), turned by
-// yaw_deg (the largest corner radius).
-double FootprintReach(const SyntheticBox& b, double x, double y, double yaw_deg) {
-    const double c = std::cos(yaw_deg * kDegToRad), s = std::sin(yaw_deg * kDegToRad);
-    double reach = 0.0;
-    for (int sx = -1; sx <= 1; sx += 2) {
-        for (int sy = -1; sy <= 1; sy += 2) {
-            const double lx = sx * b.length_m / 2.0, ly = sy * b.width_m / 2.0;
-            reach = std::max(reach, std::hypot(x + c * lx - s * ly, y + s * lx + c * ly));
-        }
-    }
-    return reach;
-}
 
 // Returns a unit vector of uniformly random direction drawn from stream `seed`.
 Eigen::Vector3d RandomUnitVector(std::uint64_t seed, std::uint64_t index) {
@@ -100,14 +87,15 @@ float FlyingPixelDepth(const std::vector<float>& z, int w, int h, int x, int y,
 
 Status SyntheticStationConfig::Validate() const {
     const SyntheticBox& b = box;
-    for (auto [name, v] : {std::pair{"box.length_m", b.length_m},
-                           {"box.width_m", b.width_m},
-                           {"box.height_m", b.height_m}}) {
-        if (!Finite(v) || v <= 0.0 || v > 5.0) return Bad(name, "must be in (0, 5] metres");
+    if (auto st = ValidateSyntheticObject(b, "box"); !st) return st;
+    for (std::size_t i = 0; i < extra_objects.size(); ++i) {
+        const std::string field = "extra_objects[" + std::to_string(i) + "]";
+        if (auto st = ValidateSyntheticObject(extra_objects[i], field); !st) return st;
+        if (SyntheticObjectReach(extra_objects[i]) > disc_radius_m) {
+            return Bad(field, "reaches beyond the disc radius");
+        }
     }
-    if (!Finite(b.offset_x_m)) return Bad("box.offset_x_m", "must be finite");
-    if (!Finite(b.offset_y_m)) return Bad("box.offset_y_m", "must be finite");
-    if (!Finite(b.yaw_deg)) return Bad("box.yaw_deg", "must be finite");
+    if (intruder_pose && *intruder_pose < 0) return Bad("intruder_pose", "must be a pose index");
     if (auto st = camera.Validate("camera"); !st) return st;
     if (!Finite(disc_radius_m) || disc_radius_m <= 0.0 || disc_radius_m > 5.0) {
         return Bad("disc_radius_m", "must be in (0, 5] metres");
@@ -118,7 +106,7 @@ Status SyntheticStationConfig::Validate() const {
     if (!Finite(floor_drop_m) || floor_drop_m < disc_thickness_m || floor_drop_m > 10.0) {
         return Bad("floor_drop_m", "must be in disc_thickness_m..10 metres");
     }
-    const double reach = FootprintReach(b, b.offset_x_m, b.offset_y_m, b.yaw_deg);
+    const double reach = SyntheticObjectReach(b);
     if (reach > disc_radius_m) {
         return Bad("box", "the footprint reaches " + std::to_string(reach) +
                               " m from the axis, beyond the disc radius " +
@@ -170,8 +158,7 @@ Status SyntheticStationConfig::Validate() const {
         if (!Finite(moved_dx_m)) return Bad("moved_dx_m", "must be finite");
         if (!Finite(moved_dy_m)) return Bad("moved_dy_m", "must be finite");
         if (!Finite(moved_dyaw_deg)) return Bad("moved_dyaw_deg", "must be finite");
-        const double moved_reach = FootprintReach(
-            b, b.offset_x_m + moved_dx_m, b.offset_y_m + moved_dy_m, b.yaw_deg + moved_dyaw_deg);
+        const double moved_reach = SyntheticObjectReach(b, moved_dx_m, moved_dy_m, moved_dyaw_deg);
         if (moved_reach > disc_radius_m) {
             return Bad("moved_dx_m", "the moved box would reach " + std::to_string(moved_reach) +
                                          " m from the axis, beyond the disc");
@@ -194,7 +181,7 @@ double SyntheticTrueAngleDeg(const SyntheticStationConfig& config, int pose, dou
 }
 
 BoxDimensions SyntheticGroundTruth(const SyntheticBox& box) {
-    return {std::max(box.length_m, box.width_m), std::min(box.length_m, box.width_m), box.height_m};
+    return SyntheticEnclosingCuboid(box);
 }
 
 SyntheticScene MakeSyntheticScene(const SyntheticStationConfig& config) {
@@ -307,8 +294,20 @@ DepthImage RenderDepthFrame(const SyntheticScene& scene, double true_angle_rad,
 
 Result<Session> RenderSyntheticSession(const SyntheticStationConfig& config, int poses,
                                        int frames) {
-    if (auto st = config.Validate(); !st) return st.error();
     if (poses < 1 || poses > 360) return Bad("poses", "must be in 1..360");
+    std::vector<double> angles(static_cast<std::size_t>(poses));
+    for (int p = 0; p < poses; ++p) angles[static_cast<std::size_t>(p)] = 360.0 * p / poses;
+    return RenderSyntheticSession(config, angles, frames);
+}
+
+Result<Session> RenderSyntheticSession(const SyntheticStationConfig& config,
+                                       const std::vector<double>& angles_deg, int frames) {
+    if (auto st = config.Validate(); !st) return st.error();
+    const int poses = static_cast<int>(angles_deg.size());
+    if (poses < 1 || poses > 360) return Bad("poses", "must be in 1..360");
+    for (double a : angles_deg) {
+        if (!Finite(a) || std::abs(a) > 3600.0) return Bad("angles", "must be finite degrees");
+    }
     if (frames < 1 || frames > kMaxFramesPerPose) {
         return Bad("frames", "must be in 1.." + std::to_string(kMaxFramesPerPose));
     }
@@ -323,11 +322,12 @@ Result<Session> RenderSyntheticSession(const SyntheticStationConfig& config, int
     session.camera = config.camera;
     session.calibration = scene.recorded_calibration;
     session.direction = TurntableDirection::kCcw;
-    session.ground_truth = SyntheticGroundTruth(config.box);
+    // Two objects have no single size.
+    if (config.extra_objects.empty()) session.ground_truth = SyntheticGroundTruth(config.box);
     session.poses.resize(static_cast<std::size_t>(poses));
     for (int p = 0; p < poses; ++p) {
         SessionPose& pose = session.poses[static_cast<std::size_t>(p)];
-        pose.angle_deg = 360.0 * p / poses;
+        pose.angle_deg = angles_deg[static_cast<std::size_t>(p)];
         pose.frames.resize(static_cast<std::size_t>(frames));
         for (int f = 0; f < frames; ++f) pose.frame_paths.push_back(SessionFramePath(p, f));
     }

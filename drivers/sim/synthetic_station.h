@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 #include "drivers/sim/sensor_noise.h"
 #include "pipeline/result.h"
@@ -14,14 +15,40 @@ namespace boxd {
 
 // NoiseModel, NoiseModelName() and ParseNoiseModel() live in pipeline/sensor_noise.h.
 
-// Where the box stands on the table at pose 0, in the table frame (metres, degrees).
+// The shapes of synthetic objects (synthetic_objects.h builds them).
+enum class SyntheticShape {
+    kBox,            // length x width x height, with the real-parcel features below
+    kCylinder,       // a tube standing: diameter = length = width
+    kLyingCylinder,  // a tube on its side along the length: diameter = width = height
+    kLShape,         // the length x width footprint without one quarter, full height
+    kBag,            // a soft bag: a well rounded, bulging length x width x height core
+};
+
+// An object on the table and where it stands at pose 0, in the table frame (metres, degrees).
+// The ideal box (a kBox without features) is rendered exactly; every other object as a mesh.
 struct SyntheticBox {
     double length_m = 0.455;
     double width_m = 0.33;
     double height_m = 0.46;
-    double offset_x_m = 0.0;  // box centre relative to the axis, table frame
+    double offset_x_m = 0.0;  // centre of the footprint relative to the axis, table frame
     double offset_y_m = 0.0;
-    double yaw_deg = 0.0;  // rotation of the box about the table axis at pose 0
+    double yaw_deg = 0.0;  // rotation of the object about the table axis at pose 0
+    SyntheticShape shape = SyntheticShape::kBox;
+    // Real-parcel features of a box.
+    double edge_radius_m = 0.0;      // rounded edges and corners
+    double bulge_m = 0.0;            // each side face bulges out by this much at its middle
+    double bulge_top_m = 0.0;        // the top face, likewise
+    double strap_thickness_m = 0.0;  // a band over the top and down both ends (along the length)
+    double strap_width_m = 0.025;
+    double label_thickness_m = 0.0;  // a label on the +width side
+    double flap_deg = 0.0;           // a top flap hinged at the +length top edge, this far open
+
+    // Returns true for a box without features.
+    bool IsIdealBox() const {
+        return shape == SyntheticShape::kBox && edge_radius_m == 0.0 && bulge_m == 0.0 &&
+               bulge_top_m == 0.0 && strap_thickness_m == 0.0 && label_thickness_m == 0.0 &&
+               flap_deg == 0.0;
+    }
 };
 
 // The camera placement: it looks at a point on the axis `aim_height_m` above the table top,
@@ -60,6 +87,10 @@ struct SyntheticStationConfig {
     // on (for OBJECT_MOVED tests).
     std::optional<int> moved_at_pose;
     double moved_dx_m = 0.05, moved_dy_m = 0.0, moved_dyaw_deg = 10.0;
+    // More objects standing on the table (a second parcel: MULTIPLE_OBJECTS tests).
+    std::vector<SyntheticBox> extra_objects;
+    // Optional: a hand reaches into the measuring volume in this pose only.
+    std::optional<int> intruder_pose;
 
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;
@@ -89,12 +120,18 @@ std::uint64_t SyntheticFrameSeed(std::uint64_t seed, int pose, int frame);
 // commanded angle plus a seeded N(0, angle_error_deg) error (none for pose 0).
 double SyntheticTrueAngleDeg(const SyntheticStationConfig& config, int pose, double commanded_deg);
 
-// Returns the box's true size as a session reports it (length >= width).
+// Returns the object's true size as a session reports it: the smallest cuboid standing on the
+// table that it fits in (length >= width).
 BoxDimensions SyntheticGroundTruth(const SyntheticBox& box);
 
 // Returns a whole session: `poses` poses evenly spaced over 360 degrees, `frames` raw frames
 // each, the recorded calibration, and the box's true size as ground truth. Poses render on two
 // threads; the result does not depend on it.
 Result<Session> RenderSyntheticSession(const SyntheticStationConfig& config, int poses, int frames);
+
+// Returns a whole session whose poses stand at the commanded angles `angles_deg` (1..360 of
+// them, any spacing).
+Result<Session> RenderSyntheticSession(const SyntheticStationConfig& config,
+                                       const std::vector<double>& angles_deg, int frames);
 
 }  // namespace boxd

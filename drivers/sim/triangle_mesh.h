@@ -1,0 +1,45 @@
+#pragma once
+// Triangle meshes of the synthetic station's objects (parcels that are not ideal boxes): a
+// box with rounded edges and bulging faces, straps, labels and flaps as thin boxes, cylinders.
+// Built in the object's own frame: origin at the centre of its footprint on the table top, +z up,
+// +x along the length.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace boxd {
+
+struct TriangleMesh {
+    std::vector<Eigen::Vector3f> vertices;
+    std::vector<std::array<std::uint32_t, 3>> triangles;  // counter-clockwise seen from outside
+
+    // Appends `other`'s triangles.
+    void Append(const TriangleMesh& other);
+    // Returns this mesh moved by the rigid motion (R, t): v -> R v + t.
+    TriangleMesh Transformed(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& t) const;
+    // Returns the axis-aligned bounds (min, max) of the vertices.
+    std::array<Eigen::Vector3d, 2> Bounds() const;
+};
+
+// How a rounded, bulging box deviates from the ideal l x w x h box (all 0: the ideal box).
+struct BoxDeformation {
+    double edge_radius_m = 0.0;  // edges and corners rounded with this radius
+    double side_bulge_m = 0.0;   // each side face pushed out by this much at its middle
+    double top_bulge_m = 0.0;    // the top face, likewise
+};
+
+// Returns the closed surface of an l x w x h box standing on z = 0, centred on the z axis,
+// deformed by `deformation` (the bulge of a face falls to zero at its edges as a product of
+// parabolas, the shape of a full carton's panel), its faces cut into `cells` x `cells` quads.
+TriangleMesh MakeBoxMesh(double l, double w, double h, const BoxDeformation& deformation,
+                         int cells = 64);
+
+// Returns the axis-aligned box [lo, hi] (a strap, a label, a flap panel before it is turned).
+TriangleMesh MakeCuboidMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+
+// Returns a closed cylinder of `radius` and `length` along +z from z = 0, with `segments` sides.
+TriangleMesh MakeCylinderMesh(double radius, double length, int segments = 360);
+
+}  // namespace boxd

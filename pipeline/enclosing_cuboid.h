@@ -1,0 +1,72 @@
+#pragma once
+// Stage 7: the smallest enclosing cuboid (SPEC section 5) — the cuboid standing on the table
+// that the object's OUTERMOST real surface fits in — and whether the object is a cuboid at all.
+//
+// Method. Sensor noise scatters every surface point by σ (1-3 mm), so the extreme points of a
+// cloud lie 2-4 σ outside the surface: taking them inflates every box. Averaging removes the
+// noise but finds the MEAN surface, which lies inside a bulge, a strap or a tube's tangent.
+// Both are avoided by working on small surface cells (about 1 x 3 cm): a cell's mean offset has
+// the noise of σ / √n, and the surface reaches at least as far as the cell's lower confidence
+// bound, mean − k·se. The bound used is the largest such bound over the M cells of a face or a
+// direction, with k = Φ⁻¹(1 − α/M): with probability 1 − α, noise alone moves no cell's bound
+// outside the true surface (Bonferroni over the cells), so noise does not inflate the box, while
+// a real bulge, strap or label — many cells out by millimetres — does count.
+//   - Cuboids: the face fit of box_fit.h locates each face's plane with all its points (the
+//     precision of an ideal box); each face's excess is the largest cell bound outside that plane.
+//   - Other objects (tubes, bags, L-shapes, open flaps): the support function of the surface,
+//     h(φ) = the largest cell bound along direction φ over cells of the outer layer seen from φ,
+//     for φ every degree (then every 0.1 degree near the best); the footprint is the rectangle of
+//     least area (h(φ) + h(φ + π)) (h(φ + π/2) + h(φ − π/2)), the height the top's bound.
+// The object is a cuboid when its box fit succeeded, its footprint fills the rectangle and no
+// face stands out of its plane by more than a small fraction of the box.
+
+#include <Eigen/Core>
+#include <array>
+
+#include "pipeline/box_fit.h"
+#include "pipeline/fusion.h"
+#include "pipeline/result.h"
+
+namespace boxd {
+
+struct EnvelopeConfig {
+    double cell_along_m = 0.012;    // cell size along a face (and across the top)
+    double cell_height_m = 0.03;    // cell size up a side face
+    int min_cell_points = 12;       // smaller cells are not judged
+    double false_alarm = 0.05;      // chance that noise alone moves a flat face outwards
+    double edge_margin_m = 0.015;   // points this close to a face's edges belong to no cell of it
+    double inward_band_sigmas = 3.0;  // a face's points lie from this far inside its plane ...
+    double outward_band_m = 0.06;     // ... to this far outside it
+    int directions = 180;             // footprint orientations over 180 degrees (irregular)
+    int max_points = 40000;           // the support function works on an even subsample
+    double layer_sigmas = 5.0;        // a cell's outer layer: within this many σ of its extreme
+    double min_z_m = 0.012;           // points lower than this are table, not footprint
+    double footprint_cell_m = 0.01;   // occupancy grid of the fill ratio
+    // Shape: a cuboid's footprint fills its rectangle to at least min_fill, and no face stands
+    // out of its plane by more than max_relative_excess of the box's size across that face.
+    double min_fill = 0.88;
+    double max_relative_excess = 0.03;
+
+    // Returns an error naming the first invalid field, or Ok.
+    Status Validate() const;
+};
+
+struct EnclosingCuboid {
+    double length_m = 0.0;  // footprint side along length_axis, >= width_m
+    double width_m = 0.0;
+    double height_m = 0.0;  // above the table top
+    Eigen::Vector2d center_m = Eigen::Vector2d::Zero();  // footprint centre, table frame
+    Eigen::Vector2d length_axis = Eigen::Vector2d::UnitX();
+    bool cuboid = true;                  // flat faces at right angles filling the rectangle
+    double fill = 1.0;                   // footprint area over rectangle area
+    double max_relative_excess = 0.0;    // largest face excess over the box size across it
+    std::array<double, 5> excess_m{};    // +u, -u, +v, -v sides and the top, beyond the faces
+    std::array<double, 3> sigma_m{};     // 1-sigma of length, width, height from the data
+};
+
+// Returns the smallest enclosing cuboid of `cloud` (table frame), given its face fit `box` (an
+// error when the cloud has no box faces), or INSUFFICIENT_DATA when no surface cell is seen.
+Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result<BoxFit>& box,
+                                           int views, const EnvelopeConfig& config);
+
+}  // namespace boxd
