@@ -1,6 +1,4 @@
 // boxd: parcel dimensioner. Parses the command line and runs one subcommand.
-#include <spdlog/spdlog.h>
-
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -33,7 +31,6 @@ int main(int argc, char** argv) {
     try {
         return run ? run() : Fail(Error{ErrorCode::kInvalidInput, "no subcommand"});
     } catch (const std::exception& e) {
-        spdlog::critical("internal failure: {}", e.what());
-        return kExitInternal;
+        return Fail(Error{ErrorCode::kInternal, std::string("internal failure: ") + e.what()});
     }
 }
