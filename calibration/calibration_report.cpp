@@ -4,12 +4,11 @@
 #include <string>
 
 #include "calibration/station_calibrator.h"
+#include "pipeline/station_calibration_json.h"
 
 namespace boxd {
 
 namespace {
-
-nlohmann::json Vec3(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 
 nlohmann::json Dims(const BoxDimensions& d) {
     return {{"length_m", d.length_m}, {"width_m", d.width_m}, {"height_m", d.height_m}};
@@ -20,17 +19,10 @@ constexpr double kPoorlyObservedScaleSigma = 0.002;
 
 }  // namespace
 
-nlohmann::json CalibrationToJson(const StationCalibration& c) {
-    return {{"table_center_m", Vec3(c.table_center_m)},
-            {"table_axis", Vec3(c.table_axis)},
-            {"depth_offset_m", c.depth_offset_m},
-            {"depth_scale", c.depth_scale}};
-}
-
 nlohmann::json ToJson(const CalibrationReport& r) {
     nlohmann::json j;
-    j["calibration"] = CalibrationToJson(r.calibration);
-    j["recorded_calibration"] = CalibrationToJson(r.recorded);
+    j["calibration"] = ToJson(r.calibration);
+    j["recorded_calibration"] = ToJson(r.recorded);
     j["quality"] = {
         {"poses_used", r.poses_used},
         {"table_points", r.table_points},

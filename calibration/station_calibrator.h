@@ -83,11 +83,9 @@ struct CalibrationReport {
 Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDimensions& reference,
                                            const CalibrationConfig& config);
 
-// Returns the SPEC section 3 calibration block of `c` as JSON.
-nlohmann::json CalibrationToJson(const StationCalibration& c);
-
 // Returns the report as JSON: {"calibration": {...}, "quality": {...}, "uncertainty": {...}}.
-// The "calibration" member is what a session's or a daemon config's calibration block holds.
+// The "calibration" member is what a session's or a daemon config's calibration block holds
+// (pipeline/station_calibration_json.h).
 nlohmann::json ToJson(const CalibrationReport& report);
 
 // Returns the calibration file `boxd calibrate --out` writes: YAML with one `calibration:`

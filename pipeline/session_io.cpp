@@ -7,6 +7,8 @@
 #include <optional>
 #include <thread>
 
+#include "pipeline/station_calibration_json.h"
+
 namespace boxd {
 
 namespace fs = std::filesystem;
@@ -45,23 +47,6 @@ public:
         if (!(*m)->is_number()) return SessionError(file_, field, "must be a number");
         const double v = (*m)->get<double>();
         if (!std::isfinite(v)) return SessionError(file_, field, "must be finite");
-        return v;
-    }
-
-    Result<Eigen::Vector3d> Vector3(const json& obj, const std::string& parent,
-                                    const std::string& key) const {
-        auto m = Member(obj, parent, key);
-        if (!m) return m.error();
-        const std::string field = parent + "." + key;
-        const json& a = **m;
-        if (!a.is_array() || a.size() != 3) {
-            return SessionError(file_, field, "must be an array of 3 numbers");
-        }
-        Eigen::Vector3d v;
-        for (int i = 0; i < 3; ++i) {
-            if (!a[i].is_number()) return SessionError(file_, field, "must hold numbers");
-            v[i] = a[i].get<double>();
-        }
         return v;
     }
 
@@ -113,27 +98,8 @@ Result<CameraIntrinsics> ParseCamera(const JsonReader& r, const json& root) {
 Result<StationCalibration> ParseCalibration(const JsonReader& r, const json& root) {
     auto cal = r.Member(root, "", "calibration");
     if (!cal) return cal.error();
-    const json& j = **cal;
-    StationCalibration c;
-    auto center = r.Vector3(j, "calibration", "table_center_m");
-    if (!center) return center.error();
-    auto axis = r.Vector3(j, "calibration", "table_axis");
-    if (!axis) return axis.error();
-    auto offset = r.Number(j, "calibration", "depth_offset_m");
-    if (!offset) return offset.error();
-    c.table_center_m = *center;
-    c.table_axis = *axis;
-    c.depth_offset_m = *offset;
-    auto scale_member = r.Member(j, "calibration", "depth_scale", /*required=*/false);
-    if (!scale_member) return scale_member.error();
-    if (*scale_member != nullptr) {
-        auto scale = r.Number(j, "calibration", "depth_scale");
-        if (!scale) return scale.error();
-        c.depth_scale = *scale;
-    }
-    if (auto s = c.Validate("calibration"); !s) {
-        return SessionError(r.file(), "", s.error().message);
-    }
+    auto c = StationCalibrationFromJson(**cal, "calibration");
+    if (!c) return SessionError(r.file(), "", c.error().message);
     return c;
 }
 
@@ -353,7 +319,6 @@ Status WriteSession(const Session& session, const fs::path& dir) {
         if (e) return *e;
     }
     const auto& c = session.camera;
-    const auto& cal = session.calibration;
     json root = {
         {"format", kSessionFormat},
         {"source", session.source},
@@ -365,12 +330,7 @@ Status WriteSession(const Session& session, const fs::path& dir) {
           {"cx", c.cx},
           {"cy", c.cy},
           {"depth_unit_m", c.depth_unit_m}}},
-        {"calibration",
-         {{"table_center_m",
-           {cal.table_center_m.x(), cal.table_center_m.y(), cal.table_center_m.z()}},
-          {"table_axis", {cal.table_axis.x(), cal.table_axis.y(), cal.table_axis.z()}},
-          {"depth_offset_m", cal.depth_offset_m},
-          {"depth_scale", cal.depth_scale}}},
+        {"calibration", ToJson(session.calibration)},
         {"turntable", {{"direction", DirectionName(session.direction)}}},
         {"poses", poses},
     };

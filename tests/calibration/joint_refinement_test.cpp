@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "tests/support/expect_error.h"
+
 namespace boxd {
 namespace {
 
@@ -13,12 +15,7 @@ constexpr double kDeg = M_PI / 180.0;
 constexpr int kPoses = 6;
 constexpr int kPixelStride = 6;  // ~9 mm between samples at 0.9 m: ~1000 box points per pose
 
-// Error codes are compared as strings only here (they will become an enum).
-template <typename T>
-void ExpectError(const Result<T>& r, ErrorCode code) {
-    ASSERT_FALSE(r.ok());
-    EXPECT_EQ(r.error().code, code);
-}
+using test::ExpectError;
 
 // The true station: the camera looks ~45 degrees down at a table centre 0.9 m away and reads
 // every depth 4 mm short (a depth offset of +4 mm corrects it).

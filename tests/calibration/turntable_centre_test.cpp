@@ -4,17 +4,14 @@
 
 #include <cmath>
 
+#include "tests/support/expect_error.h"
+
 namespace boxd {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-// Error codes are compared as strings only here (they will become an enum).
-template <typename T>
-void ExpectError(const Result<T>& r, ErrorCode code) {
-    ASSERT_FALSE(r.ok());
-    EXPECT_EQ(r.error().code, code);
-}
+using test::ExpectError;
 
 TEST(FitTurntableCentre, RecoversTheCentreOfExactRotations) {
     const Eigen::Vector2d centre(0.012, -0.034);

@@ -7,16 +7,13 @@
 #include <iterator>
 #include <string>
 
+#include "tests/support/expect_error.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd {
 namespace {
 
-// Error codes are compared as strings only here (they will become an enum).
-void ExpectError(const Status& s, ErrorCode code) {
-    ASSERT_FALSE(s.ok());
-    EXPECT_EQ(s.error().code, code);
-}
+using test::ExpectError;
 
 std::string ReadAll(const std::filesystem::path& path) {
     std::ifstream in(path, std::ios::binary);

@@ -6,17 +6,14 @@
 #include <cmath>
 #include <limits>
 
+#include "tests/support/expect_error.h"
+
 namespace boxd {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
-// Error codes are compared as strings only here (they will become an enum).
-template <typename T>
-void ExpectError(const Result<T>& r, ErrorCode code) {
-    ASSERT_FALSE(r.ok());
-    EXPECT_EQ(r.error().code, code);
-}
+using test::ExpectError;
 
 // The recorded calibration of these tests: the camera looks 45 degrees down at a table centre
 // 0.9 m in front of it, so the whole fit disc is in view.

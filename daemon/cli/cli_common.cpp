@@ -1,0 +1,29 @@
+// What every subcommand shares: the one error line and exit code, and the logger.
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <cstdio>
+#include <cstdlib>
+
+#include "daemon/cli/cli.h"
+
+namespace boxd::cli {
+
+int Fail(const Error& error) {
+    std::string line = error.message;
+    for (char& c : line) {
+        if (c == '\n' || c == '\r') c = ' ';
+    }
+    std::fprintf(stderr, "boxd: error: %s: %s\n", ErrorCodeName(error.code), line.c_str());
+    return ExitCodeOf(error.code);
+}
+
+void SetupLogging() {
+    auto logger = spdlog::stderr_color_mt("boxd");
+    spdlog::set_default_logger(logger);
+    spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ %v");
+    const char* level = std::getenv("BOXD_LOG_LEVEL");
+    spdlog::set_level(level ? spdlog::level::from_str(level) : spdlog::level::info);
+}
+
+}  // namespace boxd::cli

@@ -1,0 +1,70 @@
+// boxd measure: measures a recorded session offline and prints the SPEC section 5 JSON.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "daemon/cli/cli.h"
+#include "pipeline/measure_pipeline.h"
+#include "pipeline/ply_writer.h"
+#include "pipeline/session_io.h"
+
+namespace boxd::cli {
+
+namespace {
+
+struct MeasureOptions {
+    std::string session;
+    std::string method = "footprint";
+    std::string cloud;
+};
+
+int RunMeasure(const MeasureOptions& opt) {
+    auto session = LoadSession(opt.session);
+    if (!session) return Fail(session.error());
+    const BoxMethod method = opt.method == "pca" ? BoxMethod::kPca : BoxMethod::kFootprint;
+    // The command line is an edge of the pipeline: it owns the id, the timestamps and the clock.
+    const MonotonicMs clock = SteadyClockMs();
+    const std::string started_at = UtcTimestampNow();
+    const double start_ms = clock();
+    auto out = MeasureSession(*session, MeasureConfig{}, method, clock);
+    if (!out) return Fail(out.error());
+    MeasurementResult& result = out->result;
+    result.id = "offline";
+    result.started_at = started_at;
+    result.finished_at = UtcTimestampNow();
+    result.timing_ms["capture"] = 0.0;
+    result.timing_ms["processing"] = clock() - start_ms;
+    if (!opt.cloud.empty()) {
+        // The path is the caller's: one that cannot be written is bad input (exit 2).
+        if (Status s = WritePly(opt.cloud, out->cloud); !s) {
+            return Fail(Error{ErrorCode::kInvalidInput, "--cloud: " + s.error().message});
+        }
+    }
+    const std::string text = ToJson(out->result).dump(2);
+    std::fprintf(stdout, "%s\n", text.c_str());
+    std::fflush(stdout);
+    switch (out->result.status) {
+        case MeasurementStatus::kOk:
+            return kExitOk;
+        case MeasurementStatus::kNoDim:
+            return kExitNoDim;
+        case MeasurementStatus::kFailed:
+            break;
+    }
+    return kExitInternal;
+}
+
+}  // namespace
+
+void AddMeasure(CLI::App& app, Runner& run) {
+    auto opt = std::make_shared<MeasureOptions>();
+    CLI::App* sub = app.add_subcommand("measure", "Measure a recorded session offline");
+    sub->add_option("--session", opt->session, "session folder (boxd.session/1)")->required();
+    sub->add_option("--method", opt->method, "dimension estimator")
+        ->check(CLI::IsMember({"footprint", "pca"}))
+        ->capture_default_str();
+    sub->add_option("--cloud", opt->cloud, "write the fused cloud (table frame) as a PLY file");
+    sub->callback([&run, opt] { run = [opt] { return RunMeasure(*opt); }; });
+}
+
+}  // namespace boxd::cli

@@ -1,0 +1,41 @@
+// `boxd serve`: the daemon (SPEC section 6).
+#include <CLI/CLI.hpp>
+#include <memory>
+
+#include "daemon/cli/cli.h"
+#include "daemon/service/serve_config.h"
+#include "daemon/service/service_loop.h"
+
+namespace boxd::cli {
+
+namespace {
+
+struct ServeOptions {
+    std::string config;
+    std::string listen;
+    std::string data_dir;
+};
+
+int RunServe(const ServeOptions& o) {
+    ServeOverrides overrides;
+    if (!o.listen.empty()) overrides.listen = o.listen;
+    if (!o.data_dir.empty()) overrides.data_dir = o.data_dir;
+    auto config = LoadServeConfig(o.config, overrides);
+    if (!config) return Fail(config.error());
+    Status served = RunService(std::move(*config), o.config, overrides);
+    return served ? kExitOk : Fail(served.error());
+}
+
+}  // namespace
+
+void AddServe(CLI::App& app, Runner& run) {
+    auto opts = std::make_shared<ServeOptions>();
+    CLI::App* sub = app.add_subcommand("serve", "Run the daemon (REST/JSON API, SPEC section 6)");
+    sub->add_option("--config", opts->config, "YAML config file (see config/sim.yaml)")->required();
+    sub->add_option("--listen", opts->listen, "HOST:PORT to listen on (overrides server.listen)");
+    sub->add_option("--data-dir", opts->data_dir,
+                    "folder for results, clouds and sessions (overrides storage.data_dir)");
+    sub->callback([opts, &run] { run = [opts] { return RunServe(*opts); }; });
+}
+
+}  // namespace boxd::cli

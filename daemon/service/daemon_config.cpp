@@ -1,0 +1,138 @@
+#include "daemon/service/daemon_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <charconv>
+#include <set>
+
+namespace boxd {
+
+namespace {
+
+Error ConfigError(const std::string& key, const std::string& what) {
+    return Error{ErrorCode::kInvalidInput, key + ": " + what};
+}
+
+// Rejects keys of `node` that are not in `known`: a typo must not silently keep a default.
+Status CheckKeys(const YAML::Node& node, const std::string& section,
+                 const std::set<std::string>& known) {
+    if (!node.IsMap()) return ConfigError(section, "expected a mapping");
+    for (const auto& kv : node) {
+        const std::string key = kv.first.as<std::string>();
+        if (!known.count(key)) return ConfigError(section + "." + key, "unknown key");
+    }
+    return OkStatus();
+}
+
+// Reads node[key] into `out` when present; a value of the wrong type names the key.
+template <typename T>
+Status ReadKey(const YAML::Node& node, const std::string& section, const char* key, T& out) {
+    const YAML::Node value = node[key];
+    if (!value) return OkStatus();
+    if (!value.IsScalar()) return ConfigError(section + "." + key, "expected a scalar value");
+    try {
+        out = value.as<T>();
+    } catch (const YAML::Exception&) {
+        return ConfigError(section + "." + key,
+                           "cannot read '" + value.Scalar() + "' as the expected type");
+    }
+    return OkStatus();
+}
+
+}  // namespace
+
+Result<ListenAddress> ParseListenAddress(const std::string& text, const std::string& key) {
+    ListenAddress a;
+    std::string port;
+    if (!text.empty() && text.front() == '[') {
+        const auto close = text.find(']');
+        if (close == std::string::npos || close + 1 >= text.size() || text[close + 1] != ':') {
+            return ConfigError(key, "'" + text + "' is not [HOST]:PORT");
+        }
+        a.host = text.substr(1, close - 1);
+        port = text.substr(close + 2);
+    } else {
+        const auto colon = text.rfind(':');
+        if (colon == std::string::npos || text.find(':') != colon) {
+            return ConfigError(key, "'" + text + "' is not HOST:PORT");
+        }
+        a.host = text.substr(0, colon);
+        port = text.substr(colon + 1);
+    }
+    if (a.host.empty()) return ConfigError(key, "'" + text + "' has no host");
+    const auto [end, ec] = std::from_chars(port.data(), port.data() + port.size(), a.port);
+    if (ec != std::errc() || end != port.data() + port.size() || port.empty() || a.port < 0 ||
+        a.port > 65535) {
+        return ConfigError(key, "'" + text + "' has no port in 0..65535");
+    }
+    return a;
+}
+
+Status ServerConfig::Validate() const {
+    if (listen.empty() && unix_socket.empty()) {
+        return ConfigError("server.listen", "empty, and no server.unix_socket either");
+    }
+    if (!listen.empty()) {
+        auto a = ParseListenAddress(listen, "server.listen");
+        if (!a) return a.error();
+    }
+    if (!unix_socket.empty() && unix_socket.size() >= 108) {
+        // sockaddr_un.sun_path holds 108 bytes including the terminator.
+        return ConfigError("server.unix_socket", "path longer than 107 characters");
+    }
+    if (bearer_token.find_first_of(" \t\r\n") != std::string::npos) {
+        return ConfigError("server.bearer_token", "must not contain white space");
+    }
+    if (max_body_bytes < 64) return ConfigError("server.max_body_bytes", "must be at least 64");
+    if (wait_timeout_s < 1) return ConfigError("server.wait_timeout_s", "must be at least 1");
+    if (threads < 2 || threads > 256) return ConfigError("server.threads", "must be in 2..256");
+    return OkStatus();
+}
+
+Status StorageConfig::Validate() const {
+    if (data_dir.empty()) return ConfigError("storage.data_dir", "must not be empty");
+    if (retention < 1) return ConfigError("storage.retention", "must be at least 1");
+    return OkStatus();
+}
+
+Result<ServerConfig> ParseServerConfig(const YAML::Node& node) {
+    ServerConfig c;
+    if (!node || node.IsNull()) return c;
+    if (auto s = CheckKeys(node, "server",
+                           {"listen", "unix_socket", "bearer_token", "max_body_bytes",
+                            "wait_timeout_s", "threads"});
+        !s) {
+        return s.error();
+    }
+    long long max_body = static_cast<long long>(c.max_body_bytes);
+    for (Status s : {ReadKey(node, "server", "listen", c.listen),
+                     ReadKey(node, "server", "unix_socket", c.unix_socket),
+                     ReadKey(node, "server", "bearer_token", c.bearer_token),
+                     ReadKey(node, "server", "max_body_bytes", max_body),
+                     ReadKey(node, "server", "wait_timeout_s", c.wait_timeout_s),
+                     ReadKey(node, "server", "threads", c.threads)}) {
+        if (!s) return s.error();
+    }
+    if (max_body < 0) return ConfigError("server.max_body_bytes", "must not be negative");
+    c.max_body_bytes = static_cast<std::size_t>(max_body);
+    if (auto s = c.Validate(); !s) return s.error();
+    return c;
+}
+
+Result<StorageConfig> ParseStorageConfig(const YAML::Node& node) {
+    StorageConfig c;
+    if (!node || node.IsNull()) return c;
+    if (auto s = CheckKeys(node, "storage", {"data_dir", "retention", "keep_sessions"}); !s) {
+        return s.error();
+    }
+    for (Status s : {ReadKey(node, "storage", "data_dir", c.data_dir),
+                     ReadKey(node, "storage", "retention", c.retention),
+                     ReadKey(node, "storage", "keep_sessions", c.keep_sessions)}) {
+        if (!s) return s.error();
+    }
+    if (auto s = c.Validate(); !s) return s.error();
+    return c;
+}
+
+}  // namespace boxd

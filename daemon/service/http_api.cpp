@@ -1,0 +1,214 @@
+#include "daemon/service/http_api.h"
+
+#include <httplib.h>
+#include <spdlog/spdlog.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+
+#include <chrono>
+#include <cstring>
+
+#include "daemon/service/http_response.h"
+#include "daemon/service/http_routes.h"
+#include "daemon/service/service_json.h"
+
+namespace boxd {
+
+using nlohmann::json;
+using Request = httplib::Request;
+using Response = httplib::Response;
+
+namespace {
+
+const auto kProcessStart = std::chrono::steady_clock::now();
+
+// Compares in time independent of where the strings differ, so the token cannot be guessed
+// byte by byte from response times.
+bool TokenEquals(const std::string& a, const std::string& b) {
+    unsigned char diff = a.size() == b.size() ? 0 : 1;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        diff |= static_cast<unsigned char>(a[i] ^ (i < b.size() ? b[i] : 0));
+    }
+    return diff == 0;
+}
+
+}  // namespace
+
+void AddStatusRoutes(httplib::Server& server, const ApiContext& api) {
+    server.Get("/v1/health", Guarded([api](const Request&, Response& res) {
+                   if (api.loop_alive && !api.loop_alive()) {
+                       SetError(res, ErrorCode::kLoopStalled, "the service loop does not respond");
+                       return;
+                   }
+                   SetJson(res, 200, json{{"status", "ok"}});
+               }));
+
+    server.Get("/v1/status", Guarded([api](const Request&, Response& res) {
+                   const ServiceSnapshot snapshot = api.service.Snapshot();
+                   const std::shared_ptr<Station> station = api.service.station();
+                   const long long uptime_s = std::chrono::duration_cast<std::chrono::seconds>(
+                                                  std::chrono::steady_clock::now() - kProcessStart)
+                                                  .count();
+                   SetJson(
+                       res, 200,
+                       StatusJson(snapshot, station->Devices(), station->Calibration(), uptime_s));
+               }));
+}
+
+HttpApi::HttpApi(ServerConfig config, MeasurementService& service, MeasurementStore& store,
+                 std::function<bool()> loop_alive)
+    : config_(std::move(config)),
+      service_(service),
+      store_(store),
+      loop_alive_(std::move(loop_alive)) {}
+
+HttpApi::~HttpApi() { Stop(); }
+
+void HttpApi::Register(httplib::Server& server) {
+    const int threads = config_.threads;
+    server.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+    server.set_payload_max_length(config_.max_body_bytes);
+    // httplib's default also sets SO_REUSEPORT, which would let a second daemon bind the same
+    // port and silently share its requests; SO_REUSEADDR alone allows quick restarts only.
+    server.set_socket_options([](socket_t sock) {
+        int yes = 1;
+        setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+    });
+    server.set_read_timeout(10, 0);
+    server.set_write_timeout(10, 0);
+
+    // Runs before routing (and before the body is read): the bearer token guards every POST.
+    server.set_pre_routing_handler([this](const Request& req, Response& res) {
+        // A request without Content-Length or Transfer-Encoding has no body (RFC 9112 6.3), but
+        // httplib 0.11 would wait for the client to close the connection (what `curl -X POST`
+        // without data never does). Saying so in the headers makes it read an empty body. The
+        // Request is httplib's own non-const object, handed to us as const.
+        if (!req.has_header("Content-Length") && !req.has_header("Transfer-Encoding")) {
+            const_cast<Request&>(req).headers.emplace("Content-Length", "0");
+        }
+        if (req.method != "POST" || config_.bearer_token.empty()) {
+            return httplib::Server::HandlerResponse::Unhandled;
+        }
+        const std::string auth = req.get_header_value("Authorization");
+        const std::string prefix = "Bearer ";
+        if (auth.rfind(prefix, 0) == 0 &&
+            TokenEquals(auth.substr(prefix.size()), config_.bearer_token)) {
+            return httplib::Server::HandlerResponse::Unhandled;
+        }
+        res.set_header("WWW-Authenticate", "Bearer");
+        SetError(res, ErrorCode::kUnauthorized, "POST requests need a valid bearer token");
+        return httplib::Server::HandlerResponse::Handled;
+    });
+
+    // Any error status a handler left without a body (unknown route 404, oversize body 413,
+    // unreadable request 400) gets the JSON error form too.
+    server.set_error_handler(
+        httplib::Server::HandlerWithResponse([](const Request& req, Response& res) {
+            if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+            switch (res.status) {
+                case 404:
+                    SetError(res, ErrorCode::kNotFound, "no route " + req.method + " " + req.path);
+                    break;
+                case 413:
+                    SetError(res, ErrorCode::kPayloadTooLarge, "the request body is too large");
+                    break;
+                case 400:
+                    SetError(res, ErrorCode::kBadRequest, "malformed request");
+                    break;
+                default:
+                    // Statuses the HTTP library sets itself (a range it cannot serve, a URI
+                    // too long): the status stays, the code is the category's.
+                    SetError(res, res.status,
+                             res.status < 500 ? ErrorCode::kBadRequest : ErrorCode::kInternal,
+                             "the request failed with HTTP status " + std::to_string(res.status));
+            }
+            return httplib::Server::HandlerResponse::Handled;
+        }));
+    server.set_exception_handler([](const Request&, Response& res, std::exception_ptr) {
+        SetError(res, ErrorCode::kInternal, "internal failure");
+    });
+    server.set_logger([](const Request& req, const Response& res) {
+        spdlog::debug("http {} {} -> {}", req.method, req.path, res.status);
+    });
+
+    const ApiContext api{config_, service_, store_, loop_alive_};
+    AddStatusRoutes(server, api);
+    AddMeasurementRoutes(server, api);
+    AddCalibrationRoutes(server, api);
+}
+
+Status HttpApi::Start() {
+    if (!config_.listen.empty()) {
+        auto address = ParseListenAddress(config_.listen, "server.listen");
+        if (!address) return address.error();
+        auto server = std::make_unique<httplib::Server>();
+        Register(*server);
+        if (address->port == 0) {
+            tcp_port_ = server->bind_to_any_port(address->host);
+        } else if (server->bind_to_port(address->host, address->port)) {
+            tcp_port_ = address->port;
+        }
+        if (tcp_port_ <= 0) {
+            tcp_port_ = 0;
+            return Error{ErrorCode::kBindFailed, "server.listen: cannot listen on " +
+                                                     config_.listen + ": " + std::strerror(errno)};
+        }
+        servers_.push_back(std::move(server));
+    }
+    if (!config_.unix_socket.empty()) {
+        // A socket file left by a previous run would make bind() fail; anything else at that
+        // path is not ours to remove.
+        struct stat st {};
+        if (lstat(config_.unix_socket.c_str(), &st) == 0 && S_ISSOCK(st.st_mode)) {
+            ::unlink(config_.unix_socket.c_str());
+        }
+        auto server = std::make_unique<httplib::Server>();
+        Register(*server);
+        server->set_address_family(AF_UNIX);
+        if (!server->bind_to_port(config_.unix_socket, 80)) {
+            return Error{ErrorCode::kBindFailed, "server.unix_socket: cannot listen on " +
+                                                     config_.unix_socket + ": " +
+                                                     std::strerror(errno)};
+        }
+        servers_.push_back(std::move(server));
+        unix_bound_ = true;
+    }
+    for (auto& server : servers_) {
+        httplib::Server* s = server.get();
+        threads_.emplace_back([s] { s->listen_after_bind(); });
+    }
+    // Serve before announcing readiness: READY=1 follows Start().
+    for (auto& server : servers_) {
+        for (int i = 0; i < 500 && !server->is_running(); ++i) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        }
+    }
+    if (!config_.listen.empty()) {
+        const std::string host = ParseListenAddress(config_.listen, "server.listen")->host;
+        spdlog::info("listening on http://{}:{}",
+                     host.find(':') == std::string::npos ? host : "[" + host + "]", tcp_port_);
+    }
+    if (!config_.unix_socket.empty()) spdlog::info("listening on unix:{}", config_.unix_socket);
+    return OkStatus();
+}
+
+void HttpApi::Stop() {
+    for (auto& server : servers_) server->stop();
+    for (auto& t : threads_) {
+        if (t.joinable()) t.join();
+    }
+    threads_.clear();
+    servers_.clear();
+    if (unix_bound_) ::unlink(config_.unix_socket.c_str());
+    unix_bound_ = false;
+}
+
+bool HttpApi::Running() const {
+    if (servers_.empty()) return false;
+    for (const auto& server : servers_) {
+        if (!server->is_running()) return false;
+    }
+    return true;
+}
+
+}  // namespace boxd

@@ -1,0 +1,57 @@
+#pragma once
+// HttpApi: the REST/JSON API of SPEC section 6 over cpp-httplib, on a TCP address and/or a Unix
+// socket. The routes are in http_routes.h; handlers only read the store and talk to the
+// MeasurementService; no exception leaves a handler, and every error is
+// {"error": {"code", "message"}} with its HTTP status.
+
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "daemon/service/daemon_config.h"
+#include "daemon/service/measurement_service.h"
+#include "daemon/service/measurement_store.h"
+
+namespace httplib {
+class Server;
+}
+
+namespace boxd {
+
+class HttpApi {
+public:
+    // `loop_alive` tells GET /v1/health whether the service loop still runs.
+    HttpApi(ServerConfig config, MeasurementService& service, MeasurementStore& store,
+            std::function<bool()> loop_alive);
+    // Stops the listeners.
+    ~HttpApi();
+    HttpApi(const HttpApi&) = delete;
+    HttpApi& operator=(const HttpApi&) = delete;
+
+    // Binds the configured TCP address and Unix socket and starts serving; returns an error
+    // naming the address that cannot be bound.
+    Status Start();
+    // Stops serving and waits for the listener threads (requests in flight finish first).
+    void Stop();
+    // Returns true while every listener runs.
+    bool Running() const;
+    // Returns the bound TCP port (the configured one, or the one picked for port 0), or 0.
+    int tcp_port() const { return tcp_port_; }
+
+private:
+    void Register(httplib::Server& server);
+
+    ServerConfig config_;
+    MeasurementService& service_;
+    MeasurementStore& store_;
+    std::function<bool()> loop_alive_;
+    std::vector<std::unique_ptr<httplib::Server>> servers_;
+    std::vector<std::thread> threads_;
+    int tcp_port_ = 0;
+    bool unix_bound_ = false;
+};
+
+}  // namespace boxd

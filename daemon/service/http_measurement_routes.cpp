@@ -1,0 +1,111 @@
+// The measurement routes: start one (and wait for it), the stored results and their clouds.
+#include <charconv>
+#include <fstream>
+#include <sstream>
+
+#include "daemon/service/http_response.h"
+#include "daemon/service/http_routes.h"
+
+namespace boxd {
+
+using nlohmann::json;
+using Request = httplib::Request;
+using Response = httplib::Response;
+
+namespace {
+
+std::string ReadFile(const std::filesystem::path& path, bool& ok) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    ok = static_cast<bool>(in) || in.eof();
+    return ss.str();
+}
+
+}  // namespace
+
+void AddMeasurementRoutes(httplib::Server& server, const ApiContext& api) {
+    server.Post("/v1/measure", Guarded([api](const Request& req, Response& res) {
+                    const std::optional<bool> wait = BoolParam(req, "wait");
+                    if (!wait) {
+                        SetError(res, ErrorCode::kBadRequest, "wait must be 0, 1, true or false");
+                        return;
+                    }
+                    if (!JsonObjectBody(req, res, false)) return;
+                    Result<std::string> id = api.service.Start();
+                    if (!id) {
+                        SetError(res, id.error());
+                        return;
+                    }
+                    res.set_header("Location", "/v1/measurements/" + *id);
+                    if (!*wait) {
+                        SetJson(res, 202, json{{"id", *id}});
+                        return;
+                    }
+                    Result<MeasurementResult> result =
+                        api.service.WaitFor(*id, std::chrono::seconds(api.config.wait_timeout_s));
+                    if (result) {
+                        SetJson(res, 200, ToJson(*result));
+                    } else if (result.error().code == ErrorCode::kTimeout) {
+                        SetJson(res, 202, json{{"id", *id}});  // still running: poll by id
+                    } else {
+                        SetError(res, result.error());
+                    }
+                }));
+
+    server.Get(
+        "/v1/measurements", Guarded([api](const Request& req, Response& res) {
+            int limit = 20;
+            if (req.has_param("limit")) {
+                const std::string v = req.get_param_value("limit");
+                const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), limit);
+                if (ec != std::errc() || end != v.data() + v.size() || limit < 1 || limit > 1000) {
+                    SetError(res, ErrorCode::kBadRequest, "limit must be an integer in 1..1000");
+                    return;
+                }
+            }
+            auto list = api.store.List(limit);
+            if (!list) {
+                SetError(res, list.error());
+                return;
+            }
+            SetJson(res, 200, json{{"measurements", *list}});
+        }));
+
+    server.Get(R"(/v1/measurements/([^/]+))", Guarded([api](const Request& req, Response& res) {
+                   const std::string id = req.matches[1];
+                   auto m = id == "last" ? api.store.Last() : api.store.Get(id);
+                   if (!m) {
+                       SetError(res, m.error());
+                   } else if (!*m) {
+                       SetError(res, ErrorCode::kNotFound,
+                                id == "last" ? "no measurement yet" : "no measurement " + id);
+                   } else {
+                       SetJson(res, 200, **m);
+                   }
+               }));
+
+    server.Get(R"(/v1/measurements/([^/]+)/cloud\.ply)",
+               Guarded([api](const Request& req, Response& res) {
+                   const std::string id = req.matches[1];
+                   auto path = api.store.CloudPath(id);
+                   if (!path) {
+                       SetError(res, path.error());
+                       return;
+                   }
+                   if (!*path) {
+                       SetError(res, ErrorCode::kNotFound, "no cloud for measurement " + id);
+                       return;
+                   }
+                   bool ok = false;
+                   std::string data = ReadFile(**path, ok);
+                   if (!ok || data.empty()) {
+                       SetError(res, ErrorCode::kNotFound, "the cloud of " + id + " is gone");
+                       return;
+                   }
+                   res.set_header("Content-Disposition", "attachment; filename=\"" + id + ".ply\"");
+                   res.set_content(std::move(data), "application/octet-stream");
+               }));
+}
+
+}  // namespace boxd

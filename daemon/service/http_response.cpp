@@ -1,0 +1,70 @@
+#include "daemon/service/http_response.h"
+
+#include <spdlog/spdlog.h>
+
+#include <exception>
+
+#include "daemon/service/service_json.h"
+
+namespace boxd {
+
+using nlohmann::json;
+using Request = httplib::Request;
+using Response = httplib::Response;
+
+void SetError(Response& res, int http_status, ErrorCode code, const std::string& message) {
+    res.status = http_status;
+    res.set_content(json{{"error", ToJson(Error{code, message})}}.dump(), "application/json");
+}
+
+void SetError(Response& res, ErrorCode code, const std::string& message) {
+    SetError(res, HttpStatusOf(code), code, message);
+}
+
+void SetError(Response& res, const Error& error) { SetError(res, error.code, error.message); }
+
+void SetJson(Response& res, int http_status, const json& body) {
+    res.status = http_status;
+    res.set_content(body.dump(), "application/json");
+}
+
+httplib::Server::Handler Guarded(std::function<void(const Request&, Response&)> handler) {
+    return [handler = std::move(handler)](const Request& req, Response& res) {
+        try {
+            handler(req, res);
+        } catch (const std::exception& e) {
+            spdlog::error("{} {}: internal failure: {}", req.method, req.path, e.what());
+            SetError(res, ErrorCode::kInternal, e.what());
+        } catch (...) {
+            SetError(res, ErrorCode::kInternal, "unknown failure");
+        }
+    };
+}
+
+std::optional<bool> BoolParam(const Request& req, const char* name) {
+    if (!req.has_param(name)) return false;
+    const std::string v = req.get_param_value(name);
+    if (v == "1" || v == "true" || v.empty()) return true;
+    if (v == "0" || v == "false") return false;
+    return std::nullopt;
+}
+
+std::optional<json> JsonObjectBody(const Request& req, Response& res, bool required) {
+    if (req.body.empty()) {
+        if (!required) return json::object();
+        SetError(res, ErrorCode::kBadRequest, "a JSON object body is required");
+        return std::nullopt;
+    }
+    json body = json::parse(req.body, nullptr, false);
+    if (body.is_discarded()) {
+        SetError(res, ErrorCode::kBadRequest, "the body is not valid JSON");
+        return std::nullopt;
+    }
+    if (!body.is_object()) {
+        SetError(res, ErrorCode::kBadRequest, "the body must be a JSON object");
+        return std::nullopt;
+    }
+    return body;
+}
+
+}  // namespace boxd

@@ -1,0 +1,33 @@
+#pragma once
+// The routes of the HTTP API (SPEC section 6), grouped by concern; HttpApi registers them on each
+// listener. The handlers only read the store and talk to the MeasurementService.
+
+#include <functional>
+
+#include "daemon/service/daemon_config.h"
+#include "daemon/service/measurement_service.h"
+#include "daemon/service/measurement_store.h"
+
+namespace httplib {
+class Server;
+}
+
+namespace boxd {
+
+// What the handlers use; everything it refers to outlives the servers.
+struct ApiContext {
+    const ServerConfig& config;
+    MeasurementService& service;
+    MeasurementStore& store;
+    const std::function<bool()>& loop_alive;  // GET /v1/health: the service loop still runs
+};
+
+// GET /v1/health, GET /v1/status.
+void AddStatusRoutes(httplib::Server& server, const ApiContext& api);
+// POST /v1/measure, GET /v1/measurements, /v1/measurements/{id} (and "last"),
+// /v1/measurements/{id}/cloud.ply.
+void AddMeasurementRoutes(httplib::Server& server, const ApiContext& api);
+// POST /v1/calibrate, GET /v1/calibration.
+void AddCalibrationRoutes(httplib::Server& server, const ApiContext& api);
+
+}  // namespace boxd

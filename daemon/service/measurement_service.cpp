@@ -1,0 +1,381 @@
+#include "daemon/service/measurement_service.h"
+
+#include <spdlog/spdlog.h>
+
+#include <exception>
+
+#include "daemon/service/measurement_log.h"
+
+namespace boxd {
+
+using nlohmann::json;
+
+namespace {
+
+// WaitFor answers from the results kept in memory: a waiter wakes long before this many more
+// measurements can finish.
+constexpr std::size_t kRecentResults = 8;
+
+MeasurementResult FailedResult(const Error& error) {
+    MeasurementResult r;
+    r.status = MeasurementStatus::kFailed;
+    r.reason = MeasurementReason{error.code, error.message};
+    return r;
+}
+
+}  // namespace
+
+const char* ServiceStateName(ServiceState s) {
+    switch (s) {
+        case ServiceState::kStarting:
+            return "starting";
+        case ServiceState::kIdle:
+            return "idle";
+        case ServiceState::kMeasuring:
+            return "measuring";
+        case ServiceState::kCalibrating:
+            return "calibrating";
+        case ServiceState::kError:
+            return "error";
+    }
+    return "error";
+}
+
+MeasurementService::MeasurementService(MeasurementStore& store, std::shared_ptr<Station> station,
+                                       bool keep_sessions)
+    : store_(store), station_(std::move(station)), keep_sessions_(keep_sessions) {
+    auto history = CalibrationHistory::Open(store_.data_dir());
+    if (history) {
+        history_ = std::move(*history);
+    } else {
+        spdlog::warn("calibration history unavailable: {}", history.error().message);
+    }
+}
+
+Result<std::vector<json>> MeasurementService::ListCalibrations(int limit) {
+    if (!history_)
+        return Error{ErrorCode::kStorageError, "the calibration history is not available"};
+    return history_->List(limit);
+}
+
+MeasurementService::~MeasurementService() {
+    Abort();
+    Join();
+}
+
+void MeasurementService::set_on_change(std::function<void()> on_change) {
+    std::lock_guard lock(mutex_);
+    on_change_ = std::move(on_change);
+}
+
+void MeasurementService::SetProgress(const JobProgress& progress) {
+    {
+        std::lock_guard lock(mutex_);
+        progress_ = progress;
+    }
+    Notify();
+}
+
+void MeasurementService::Notify() {
+    std::function<void()> f;
+    {
+        std::lock_guard lock(mutex_);
+        f = on_change_;
+    }
+    if (f) f();
+}
+
+Status MeasurementService::OpenStation() {
+    std::shared_ptr<Station> station = this->station();
+    Status s = station->Open();
+    {
+        std::lock_guard lock(mutex_);
+        station_ok_ = s.ok();
+        station_opened_ = true;
+        if (!s) {
+            last_error_ = s.error();
+            last_error_at_ = UtcTimestampNow();
+        }
+    }
+    Notify();
+    return s;
+}
+
+std::shared_ptr<Station> MeasurementService::station() const {
+    std::lock_guard lock(mutex_);
+    return station_;
+}
+
+Status MeasurementService::ReplaceStation(std::shared_ptr<Station> station, bool keep_sessions) {
+    {
+        std::lock_guard lock(mutex_);
+        if (running_) return Error{ErrorCode::kBusy, "a measurement is running"};
+        station_ = std::move(station);
+        keep_sessions_ = keep_sessions;
+        station_ok_ = false;
+        station_opened_ = false;
+    }
+    Notify();
+    return OkStatus();
+}
+
+Result<std::thread> MeasurementService::Claim(bool calibrating) {
+    std::lock_guard lock(mutex_);
+    if (shutting_down_) return Error{ErrorCode::kShuttingDown, "the daemon is stopping"};
+    if (running_) {
+        return Error{ErrorCode::kBusy, calibrating_ ? std::string("a calibration is running")
+                                                    : "measurement " + current_id_ + " is running"};
+    }
+    running_ = true;
+    calibrating_ = calibrating;
+    cancel_ = false;
+    current_id_.clear();
+    progress_ = JobProgress{"starting", 0, 0};
+    return std::move(worker_);
+}
+
+Result<std::string> MeasurementService::Start() {
+    Result<std::thread> previous = Claim(false);
+    if (!previous) return previous.error();
+    if (previous->joinable()) previous->join();  // it has finished; only the thread is left
+
+    auto fail = [this](const Error& e) -> Result<std::string> {
+        {
+            std::lock_guard lock(mutex_);
+            running_ = false;
+            last_error_ = e;
+            last_error_at_ = UtcTimestampNow();
+        }
+        finished_cv_.notify_all();
+        Notify();
+        return e;
+    };
+    Result<std::string> id = store_.ReserveId();
+    if (!id) return fail(id.error());
+    Result<std::filesystem::path> scratch = store_.MakeScratchDir(*id);
+    if (!scratch) return fail(scratch.error());
+    {
+        std::lock_guard lock(mutex_);
+        current_id_ = *id;
+        worker_ = std::thread(&MeasurementService::Run, this, *id, *scratch, station_);
+    }
+    spdlog::info("measurement {} started", *id);
+    Notify();
+    return *id;
+}
+
+JobOutput MeasurementService::RunStation(Station& station, const JobContext& ctx) {
+    try {
+        if (!station.IsOpen()) {
+            spdlog::info("opening the station's devices");
+            if (Status s = station.Open(); !s) return JobOutput{FailedResult(s.error()), {}};
+        }
+        return station.Measure(ctx);
+    } catch (const std::exception& e) {
+        // Stations report expected failures as results; anything thrown is a defect, and it
+        // must not take the service loop down with it.
+        spdlog::critical("measurement {}: internal failure: {}", ctx.id, e.what());
+        station.RequestStop();
+        return JobOutput{FailedResult(Error{ErrorCode::kInternal, e.what()}), {}};
+    }
+}
+
+void MeasurementService::Run(std::string id, std::filesystem::path scratch,
+                             std::shared_ptr<Station> station) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::string started_at = UtcTimestampNow();
+    JobContext ctx;
+    ctx.id = id;
+    ctx.scratch_dir = scratch;
+    ctx.cancel = &cancel_;
+    {
+        std::lock_guard lock(mutex_);
+        ctx.keep_session = keep_sessions_;
+    }
+    ctx.progress = [this](const JobProgress& p) { SetProgress(p); };
+
+    JobOutput out = RunStation(*station, ctx);
+    MeasurementResult& r = out.result;
+    r.id = id;
+    r.started_at = started_at;
+    r.finished_at = UtcTimestampNow();
+    r.timing_ms["total"] =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (cancel_ && r.status != MeasurementStatus::kOk) {
+        const std::string why = r.reason ? " (" + std::string(ErrorCodeName(r.reason->code)) +
+                                               ": " + r.reason->message + ")"
+                                         : std::string();
+        r.status = MeasurementStatus::kFailed;
+        r.dimensions.reset();
+        r.reason = MeasurementReason{ErrorCode::kAborted,
+                                     "measurement aborted: the daemon is stopping" + why};
+    }
+    const Status saved = store_.Save(r, out.files);
+    store_.RemoveScratchDir(id);
+    LogMeasurement(r);
+    if (!saved) spdlog::error("measurement {} not stored: {}", id, saved.error().message);
+    const bool station_ok = station->IsOpen();
+    {
+        std::lock_guard lock(mutex_);
+        running_ = false;
+        current_id_.clear();
+        progress_ = JobProgress{};
+        last_id_ = id;
+        recent_.push_back(r);
+        if (recent_.size() > kRecentResults) recent_.pop_front();
+        ++finished_;
+        station_ok_ = station_ok;
+        if (!saved) {
+            last_error_ = saved.error();
+            last_error_at_ = r.finished_at;
+        } else if (r.status == MeasurementStatus::kFailed && r.reason) {
+            last_error_ = Error{r.reason->code, r.reason->message};
+            last_error_at_ = r.finished_at;
+        }
+    }
+    finished_cv_.notify_all();
+    Notify();
+}
+
+struct MeasurementService::CalibrationJob {
+    BoxDimensions reference;
+    bool done = false;  // guarded by mutex_
+    Result<CalibrationRun> result = Error{ErrorCode::kInternal, "not run"};
+};
+
+Result<CalibrationRun> MeasurementService::Calibrate(const BoxDimensions& reference,
+                                                     std::chrono::milliseconds timeout) {
+    Result<std::thread> previous = Claim(true);
+    if (!previous) return previous.error();
+    if (previous->joinable()) previous->join();
+    auto job = std::make_shared<CalibrationJob>();
+    job->reference = reference;
+    {
+        std::lock_guard lock(mutex_);
+        worker_ = std::thread(&MeasurementService::RunCalibration, this, job, station_);
+    }
+    spdlog::info("calibration started, reference {:.4f} x {:.4f} x {:.4f} m", reference.length_m,
+                 reference.width_m, reference.height_m);
+    Notify();
+    std::unique_lock lock(mutex_);
+    if (!finished_cv_.wait_for(lock, timeout, [&] { return job->done; })) {
+        return Error{ErrorCode::kTimeout, "the calibration is still running"};
+    }
+    return job->result;
+}
+
+void MeasurementService::RecordCalibration(const BoxDimensions& reference,
+                                           const Result<CalibrationRun>& result) {
+    if (!history_) return;
+    CalibrationRecord record;
+    record.finished_at = UtcTimestampNow();
+    record.reference = reference;
+    if (result) {
+        record.report = result->report;
+    } else {
+        record.error = result.error();
+    }
+    if (Status s = history_->Record(record); !s) {
+        spdlog::error("calibration history: {}", s.error().message);
+    }
+}
+
+void MeasurementService::RunCalibration(std::shared_ptr<CalibrationJob> job,
+                                        std::shared_ptr<Station> station) {
+    JobContext ctx;
+    ctx.id = "calibration";
+    ctx.cancel = &cancel_;
+    ctx.progress = [this](const JobProgress& p) { SetProgress(p); };
+    Result<CalibrationRun> result = Error{ErrorCode::kInternal, "not run"};
+    try {
+        Status opened = station->IsOpen() ? OkStatus() : station->Open();
+        result = opened ? station->Calibrate(ctx, job->reference)
+                        : Result<CalibrationRun>(opened.error());
+    } catch (const std::exception& e) {
+        spdlog::critical("calibration: internal failure: {}", e.what());
+        station->RequestStop();
+        result = Error{ErrorCode::kInternal, e.what()};
+    }
+    if (!result && cancel_) {
+        result = Error{ErrorCode::kAborted, "calibration aborted: the daemon is stopping"};
+    }
+    if (result) {
+        spdlog::info("calibration done: the new calibration is in force");
+    } else {
+        spdlog::error("calibration failed: {}: {}", ErrorCodeName(result.error().code),
+                      result.error().message);
+    }
+    RecordCalibration(job->reference, result);
+    const bool station_ok = station->IsOpen();
+    {
+        std::lock_guard lock(mutex_);
+        running_ = false;
+        calibrating_ = false;
+        progress_ = JobProgress{};
+        station_ok_ = station_ok;
+        if (!result) {
+            last_error_ = result.error();
+            last_error_at_ = UtcTimestampNow();
+        }
+        job->result = std::move(result);
+        job->done = true;
+    }
+    finished_cv_.notify_all();
+    Notify();
+}
+
+Result<MeasurementResult> MeasurementService::WaitFor(const std::string& id,
+                                                      std::chrono::milliseconds timeout) {
+    std::unique_lock lock(mutex_);
+    const bool done =
+        finished_cv_.wait_for(lock, timeout, [&] { return !(running_ && current_id_ == id); });
+    if (!done) return Error{ErrorCode::kTimeout, "measurement " + id + " is still running"};
+    for (auto it = recent_.rbegin(); it != recent_.rend(); ++it) {
+        if (it->id == id) return *it;
+    }
+    return Error{ErrorCode::kNotFound, "no measurement " + id};
+}
+
+void MeasurementService::Abort() {
+    std::shared_ptr<Station> station;
+    {
+        std::lock_guard lock(mutex_);
+        shutting_down_ = true;
+        if (!running_) return;
+        station = station_;
+    }
+    cancel_ = true;
+    station->RequestStop();
+}
+
+void MeasurementService::Join() {
+    std::thread t;
+    {
+        std::lock_guard lock(mutex_);
+        t = std::move(worker_);
+    }
+    if (t.joinable()) t.join();
+}
+
+bool MeasurementService::Busy() const {
+    std::lock_guard lock(mutex_);
+    return running_;
+}
+
+ServiceSnapshot MeasurementService::Snapshot() const {
+    std::lock_guard lock(mutex_);
+    ServiceSnapshot s;
+    s.state = running_      ? (calibrating_ ? ServiceState::kCalibrating : ServiceState::kMeasuring)
+              : station_ok_ ? ServiceState::kIdle
+              : station_opened_ ? ServiceState::kError
+                                : ServiceState::kStarting;  // the devices are still coming up
+    s.measurement_id = current_id_;
+    s.progress = progress_;
+    s.last_error = last_error_;
+    s.last_error_at = last_error_at_;
+    s.last_measurement_id = last_id_;
+    s.finished = finished_;
+    return s;
+}
+
+}  // namespace boxd

@@ -1,0 +1,75 @@
+#pragma once
+// MeasurementStore: the durable record of finished measurements. One SQLite database in WAL mode
+// (data_dir/boxd.db) holds every finished measurement's JSON, read back as stored (the API serves
+// it as is); fused clouds live beside it as PLY files (data_dir/clouds/<id>.ply) and, optionally,
+// captured sessions (data_dir/sessions/<id>/). A row is committed only after its files are in
+// place, so what the database lists is always servable, also after a crash or kill -9. Thread-safe.
+
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pipeline/measurement.h"
+#include "pipeline/result.h"
+
+struct sqlite3;
+
+namespace boxd {
+
+// Files a finished measurement left in its scratch folder, moved into the store by Save().
+struct MeasurementFiles {
+    std::optional<std::filesystem::path> cloud_ply;
+    std::optional<std::filesystem::path> session_dir;
+};
+
+class MeasurementStore {
+public:
+    // Returns the store in `data_dir` (created when missing), keeping at most `retention`
+    // measurements, or STORAGE_ERROR. Leftover scratch folders of an interrupted run are removed.
+    static Result<std::unique_ptr<MeasurementStore>> Open(const std::filesystem::path& data_dir,
+                                                          int retention);
+    ~MeasurementStore();
+    MeasurementStore(const MeasurementStore&) = delete;
+    MeasurementStore& operator=(const MeasurementStore&) = delete;
+
+    const std::filesystem::path& data_dir() const { return data_dir_; }
+    void set_retention(int retention);
+
+    // Returns a new id "m-000042", never handed out before in this data folder (the counter is
+    // committed before the id is returned, so a crash mid-measurement does not reuse it).
+    Result<std::string> ReserveId();
+    // Returns a fresh, empty scratch folder for measurement `id` (data_dir/tmp/<id>).
+    Result<std::filesystem::path> MakeScratchDir(const std::string& id);
+    // Removes the scratch folder of `id` (after Save, or when a run is abandoned).
+    void RemoveScratchDir(const std::string& id);
+
+    // Stores the finished measurement `result` (its id names it) as its SPEC section 5 JSON
+    // (ToJson): moves `files` into the store, commits the row, then applies the retention limit.
+    Status Save(const MeasurementResult& result, const MeasurementFiles& files);
+
+    // Returns the most recently finished measurement, or nullopt when there is none.
+    Result<std::optional<nlohmann::json>> Last();
+    // Returns measurement `id`, or nullopt when it is not stored.
+    Result<std::optional<nlohmann::json>> Get(const std::string& id);
+    // Returns up to `limit` measurements, newest first.
+    Result<std::vector<nlohmann::json>> List(int limit);
+    // Returns the path of the fused cloud of `id`, or nullopt when `id` or its cloud is missing.
+    Result<std::optional<std::filesystem::path>> CloudPath(const std::string& id);
+    // Returns the number of stored measurements.
+    Result<int> Count();
+
+private:
+    MeasurementStore(std::filesystem::path data_dir, sqlite3* db, int retention);
+    Status ApplyRetentionLocked();
+
+    std::filesystem::path data_dir_;
+    sqlite3* db_ = nullptr;
+    int retention_ = 0;
+    std::mutex mutex_;
+};
+
+}  // namespace boxd

@@ -1,0 +1,53 @@
+#include "daemon/service/serve_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+namespace boxd {
+
+Result<ServeConfig> LoadServeConfig(const std::filesystem::path& file,
+                                    const ServeOverrides& overrides) {
+    auto fail = [&file](const std::string& what) {
+        return Error{ErrorCode::kInvalidInput, file.string() + ": " + what};
+    };
+    YAML::Node root;
+    try {
+        root = YAML::LoadFile(file.string());
+    } catch (const YAML::BadFile&) {
+        return fail("cannot read the config file");
+    } catch (const YAML::Exception& e) {
+        return fail("line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+    }
+    if (!root.IsMap()) return fail("must be a map of sections");
+
+    ServeConfig config;
+    auto server = ParseServerConfig(root["server"]);
+    if (!server) return fail(server.error().message);
+    config.server = *server;
+    auto storage = ParseStorageConfig(root["storage"]);
+    if (!storage) return fail(storage.error().message);
+    config.storage = *storage;
+    auto station = ParseStationConfig(root);
+    if (!station) return fail(station.error().message);
+    config.station.station = std::move(*station);
+    config.station.config_file = std::filesystem::absolute(file);
+    if (Status s = config.station.measure.Validate(); !s) return fail(s.error().message);
+
+    // The command line wins over the file, and is validated the same way.
+    if (overrides.listen) {
+        config.server.listen = *overrides.listen;
+        if (Status s = config.server.Validate(); !s) {
+            return Error{ErrorCode::kInvalidInput, "--listen: " + s.error().message};
+        }
+    }
+    if (overrides.data_dir) {
+        config.storage.data_dir = *overrides.data_dir;
+        if (Status s = config.storage.Validate(); !s) {
+            return Error{ErrorCode::kInvalidInput, "--data-dir: " + s.error().message};
+        }
+    }
+    config.station.calibration_file =
+        std::filesystem::path(config.storage.data_dir) / "calibration.json";
+    return config;
+}
+
+}  // namespace boxd

@@ -1,0 +1,202 @@
+#include "daemon/service/service_loop.h"
+
+#include <poll.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <memory>
+
+#include "daemon/service/http_api.h"
+#include "daemon/service/measurement_service.h"
+#include "daemon/service/measurement_store.h"
+#include "daemon/service/signal_flags.h"
+#include "daemon/service/systemd_notifier.h"
+
+namespace boxd {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The loop wakes at least this often, so /v1/health can tell a live loop from a stuck one.
+constexpr auto kMaxTick = std::chrono::milliseconds(500);
+constexpr auto kStalledAfter = std::chrono::seconds(5);
+
+// A data folder or an address of the config that cannot be used at start-up is a bad config
+// (exit 2, SPEC section 4): the operator fixes the config, not the program.
+Error BadConfig(const std::string& message) { return Error{ErrorCode::kInvalidConfig, message}; }
+
+// The one-line STATUS= text of a state.
+std::string StatusLine(const ServiceSnapshot& s) {
+    switch (s.state) {
+        case ServiceState::kMeasuring:
+            return "measuring " + s.measurement_id + ": " + s.progress.stage + " pose " +
+                   std::to_string(s.progress.pose) + "/" + std::to_string(s.progress.poses);
+        case ServiceState::kError:
+            return "error: " + (s.last_error ? ErrorCodeName(s.last_error->code) +
+                                                   std::string(": ") + s.last_error->message
+                                             : std::string("devices not ready"));
+        default:
+            return std::string(ServiceStateName(s.state)) +
+                   (s.last_measurement_id.empty() ? "" : ", last " + s.last_measurement_id);
+    }
+}
+
+class ServiceLoop {
+public:
+    ServiceLoop(ServeConfig config, std::filesystem::path config_file, ServeOverrides overrides)
+        : config_(std::move(config)),
+          config_file_(std::move(config_file)),
+          overrides_(std::move(overrides)) {}
+
+    Status Run();
+
+private:
+    void Reload();
+    void Tick();
+    std::shared_ptr<Station> MakeStation(const ServeConfig& config) {
+        return std::make_shared<DeviceStation>(config.station);
+    }
+
+    ServeConfig config_;
+    std::filesystem::path config_file_;
+    ServeOverrides overrides_;
+    SystemdNotifier notifier_;
+    std::unique_ptr<MeasurementStore> store_;
+    std::unique_ptr<MeasurementService> service_;
+    std::unique_ptr<HttpApi> api_;
+    std::atomic<long long> last_tick_ms_{0};
+    std::string last_status_;
+    bool reload_pending_ = false;
+    Clock::time_point next_watchdog_;
+};
+
+long long NowMs() {
+    return std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now().time_since_epoch())
+        .count();
+}
+
+Status ServiceLoop::Run() {
+    if (!InstallSignalFlags()) {
+        return Error{ErrorCode::kInternal, "cannot install the signal handlers"};
+    }
+    auto store = MeasurementStore::Open(config_.storage.data_dir, config_.storage.retention);
+    if (!store) return BadConfig("storage.data_dir: " + store.error().message);
+    store_ = std::move(*store);
+
+    service_ = std::make_unique<MeasurementService>(*store_, MakeStation(config_),
+                                                    config_.storage.keep_sessions);
+    service_->set_on_change([] { WakeMainLoop(); });
+    last_tick_ms_ = NowMs();
+    api_ = std::make_unique<HttpApi>(config_.server, *service_, *store_, [this] {
+        return NowMs() - last_tick_ms_.load() <
+               std::chrono::duration_cast<std::chrono::milliseconds>(kStalledAfter).count();
+    });
+    if (Status s = api_->Start(); !s) return BadConfig(s.error().message);
+
+    if (Status s = service_->OpenStation(); !s) {
+        spdlog::error("the station is not ready ({}); measurements will retry the devices",
+                      s.error().message);
+    }
+    last_status_ = StatusLine(service_->Snapshot());
+    notifier_.Ready(last_status_);
+    spdlog::info("boxd serve ready: {}", last_status_);
+    if (notifier_.watchdog_interval().count() > 0) {
+        spdlog::info("systemd watchdog: pinging every {} ms",
+                     notifier_.watchdog_interval().count());
+    }
+
+    next_watchdog_ = Clock::now();
+    bool terminate = false;
+    while (!terminate) {
+        Tick();
+        auto timeout = kMaxTick;
+        if (notifier_.watchdog_interval().count() > 0) {
+            timeout = std::min(timeout, std::chrono::duration_cast<std::chrono::milliseconds>(
+                                            next_watchdog_ - Clock::now()));
+        }
+        pollfd pfd{SignalWakeFd(), POLLIN, 0};
+        poll(&pfd, 1, static_cast<int>(std::max<long long>(0, timeout.count())));
+        DrainSignalWakeFd();
+        if (TakeTerminateRequest()) terminate = true;
+        if (TakeReloadRequest()) reload_pending_ = true;
+        if (reload_pending_ && !terminate && !service_->Busy()) {
+            reload_pending_ = false;
+            Reload();
+        }
+    }
+
+    // Shutdown: refuse new work, stop the table at once, let the run record its abort, then
+    // bring the devices to rest and stop serving.
+    const bool busy = service_->Busy();
+    notifier_.Stopping(busy ? "stopping: aborting the running measurement" : "stopping");
+    spdlog::info("stopping{}", busy ? ": aborting the running measurement" : "");
+    service_->Abort();
+    service_->Join();
+    service_->station()->Shutdown();
+    api_->Stop();
+    api_.reset();
+    service_.reset();
+    spdlog::info("stopped");
+    return OkStatus();
+}
+
+void ServiceLoop::Tick() {
+    last_tick_ms_ = NowMs();
+    // WATCHDOG=1 comes from this loop only while the API still serves: a stuck loop or a dead
+    // listener stops the pings and systemd restarts the daemon.
+    if (notifier_.watchdog_interval().count() > 0 && Clock::now() >= next_watchdog_) {
+        if (api_->Running()) notifier_.Watchdog();
+        next_watchdog_ = Clock::now() + notifier_.watchdog_interval();
+    }
+    const std::string status = StatusLine(service_->Snapshot());
+    if (status != last_status_) {
+        last_status_ = status;
+        notifier_.Status(status);
+        spdlog::debug("status: {}", status);
+    }
+}
+
+void ServiceLoop::Reload() {
+    spdlog::info("SIGHUP: reloading {}", config_file_.string());
+    notifier_.Reloading();
+    auto fresh = LoadServeConfig(config_file_, overrides_);
+    if (!fresh) {
+        spdlog::error("reload failed, keeping the running config: {}", fresh.error().message);
+        notifier_.Ready(StatusLine(service_->Snapshot()));
+        return;
+    }
+    if (!(fresh->server == config_.server)) {
+        spdlog::warn("reload: server.* changes take effect at the next restart");
+        fresh->server = config_.server;
+    }
+    if (fresh->storage.data_dir != config_.storage.data_dir) {
+        spdlog::warn("reload: storage.data_dir changes take effect at the next restart");
+        fresh->storage.data_dir = config_.storage.data_dir;
+    }
+    store_->set_retention(fresh->storage.retention);
+    // The old station lets go of the devices before the new one opens them.
+    service_->station()->Shutdown();
+    if (Status s = service_->ReplaceStation(MakeStation(*fresh), fresh->storage.keep_sessions);
+        !s) {
+        spdlog::error("reload: {}", s.error().message);
+    }
+    config_ = std::move(*fresh);
+    if (Status s = service_->OpenStation(); !s) {
+        spdlog::error("reload: the station is not ready: {}", s.error().message);
+    }
+    notifier_.Ready(StatusLine(service_->Snapshot()));
+    spdlog::info("reload done");
+}
+
+}  // namespace
+
+Status RunService(ServeConfig config, const std::filesystem::path& config_file,
+                  const ServeOverrides& overrides) {
+    ServiceLoop loop(std::move(config), config_file, overrides);
+    return loop.Run();
+}
+
+}  // namespace boxd

@@ -1,0 +1,399 @@
+// The REST API over real TCP and Unix sockets (httplib::Client), in-process, with a station of
+// the test's own so every state (busy, finished, failed) can be reached on demand.
+#include "daemon/service/http_api.h"
+
+#include <gtest/gtest.h>
+#include <httplib.h>
+#include <sys/socket.h>
+
+#include <atomic>
+#include <fstream>
+#include <thread>
+
+#include "daemon/service/measurement_service.h"
+#include "daemon/service/measurement_store.h"
+#include "tests/support/temp_dir.h"
+
+namespace boxd {
+namespace {
+
+using nlohmann::json;
+using namespace std::chrono_literals;
+
+// A station whose measurement can be held mid-capture until the test releases it.
+class ScriptedStation : public Station {
+public:
+    std::atomic<bool> hold{false};
+    std::atomic<bool> in_capture{false};
+    std::atomic<int> stop_requests{0};
+    std::atomic<bool> fail_next{false};
+
+    Status Open() override {
+        open_ = true;
+        return OkStatus();
+    }
+    bool IsOpen() const override { return open_; }
+    JobOutput Measure(const JobContext& ctx) override {
+        JobOutput out;
+        ctx.progress(JobProgress{"capture", 1, 4});
+        in_capture = true;
+        while (hold && !ctx.cancelled()) std::this_thread::sleep_for(2ms);
+        in_capture = false;
+        if (ctx.cancelled()) {
+            out.result.reason = MeasurementReason{ErrorCode::kCancelled, "capture cancelled"};
+            return out;
+        }
+        if (fail_next.exchange(false)) {
+            open_ = false;
+            out.result.reason = MeasurementReason{ErrorCode::kTurntableError, "sim: stall"};
+            return out;
+        }
+        out.result.status = MeasurementStatus::kOk;
+        out.result.dimensions = MeasuredDimensions{0.4, 0.3, 0.2, 0.024, "footprint"};
+        out.result.quality.poses = 4;
+        out.result.timing_ms["capture"] = 12.0;
+        const auto ply = ctx.scratch_dir / "cloud.ply";
+        std::ofstream(ply) << "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n";
+        out.files.cloud_ply = ply;
+        return out;
+    }
+    Result<CalibrationRun> Calibrate(const JobContext& ctx,
+                                     const BoxDimensions& reference) override {
+        ctx.progress(JobProgress{"capture", 2, 4});
+        in_capture = true;
+        while (hold && !ctx.cancelled()) std::this_thread::sleep_for(2ms);
+        in_capture = false;
+        if (ctx.cancelled()) return Error{ErrorCode::kCancelled, "capture cancelled"};
+        if (reference.height_m > 1.0)
+            return Error{ErrorCode::kWrongReference, "measured 0.2 m high"};
+        return CalibrationRun{CalibrationReport{}, "2026-01-01T00:00:00.000Z", reference};
+    }
+    void RequestStop() override { ++stop_requests; }
+    void Shutdown() override { open_ = false; }
+    DeviceHealth Devices() const override {
+        DeviceHealth devices;
+        devices.turntable.ok = open_.load();
+        return devices;
+    }
+    CalibrationInForce Calibration() const override {
+        return CalibrationInForce{StationCalibration{}, "calibration.json", 42};
+    }
+
+private:
+    std::atomic<bool> open_{false};
+};
+
+class HttpApiTest : public ::testing::Test {
+protected:
+    void StartApi(ServerConfig config) {
+        auto store = MeasurementStore::Open(dir_.path(), 50);
+        ASSERT_TRUE(store) << store.error().message;
+        store_ = std::move(*store);
+        station_ = std::make_shared<ScriptedStation>();
+        service_ = std::make_unique<MeasurementService>(*store_, station_, false);
+        ASSERT_TRUE(service_->OpenStation());
+        api_ = std::make_unique<HttpApi>(config, *service_, *store_, [] { return true; });
+        ASSERT_TRUE(api_->Start());
+        ASSERT_GT(api_->tcp_port(), 0);
+        client_ = std::make_unique<httplib::Client>("127.0.0.1", api_->tcp_port());
+        client_->set_read_timeout(20, 0);
+    }
+    void SetUp() override {
+        ServerConfig config;
+        config.listen = "127.0.0.1:0";
+        StartApi(config);
+    }
+    void TearDown() override {
+        if (station_) station_->hold = false;
+        api_.reset();
+        service_.reset();
+    }
+
+    static json Body(const httplib::Result& res) { return json::parse(res->body); }
+    static void ExpectError(const httplib::Result& res, int status, const std::string& code) {
+        ASSERT_TRUE(res) << httplib::to_string(res.error());
+        EXPECT_EQ(res->status, status) << res->body;
+        const json j = json::parse(res->body, nullptr, false);
+        ASSERT_TRUE(j.is_object()) << res->body;
+        EXPECT_EQ(j["error"]["code"], code) << res->body;
+        EXPECT_TRUE(j["error"]["message"].is_string());
+    }
+    void WaitUntilIdle() {
+        for (int i = 0; i < 2000 && service_->Busy(); ++i) std::this_thread::sleep_for(5ms);
+        ASSERT_FALSE(service_->Busy());
+    }
+
+    test::TempDir dir_;
+    std::unique_ptr<MeasurementStore> store_;
+    std::shared_ptr<ScriptedStation> station_;
+    std::unique_ptr<MeasurementService> service_;
+    std::unique_ptr<HttpApi> api_;
+    std::unique_ptr<httplib::Client> client_;
+};
+
+TEST_F(HttpApiTest, HealthAndIdleStatus) {
+    auto health = client_->Get("/v1/health");
+    ASSERT_TRUE(health);
+    EXPECT_EQ(health->status, 200);
+    EXPECT_EQ(Body(health), json({{"status", "ok"}}));
+    auto status = client_->Get("/v1/status");
+    ASSERT_TRUE(status);
+    EXPECT_EQ(status->status, 200);
+    const json s = Body(status);
+    EXPECT_EQ(s["state"], "idle");
+    EXPECT_TRUE(s["progress"].is_null());
+    EXPECT_TRUE(s["last_error"].is_null());
+    EXPECT_EQ(s["calibration_age_s"], 42);
+    EXPECT_EQ(s["devices"]["turntable"]["ok"], true);
+}
+
+TEST_F(HttpApiTest, NoMeasurementYetIs404) {
+    ExpectError(client_->Get("/v1/measurements/last"), 404, "NOT_FOUND");
+    ExpectError(client_->Get("/v1/measurements/m-000001"), 404, "NOT_FOUND");
+    ExpectError(client_->Get("/v1/measurements/m-000001/cloud.ply"), 404, "NOT_FOUND");
+    auto list = client_->Get("/v1/measurements");
+    ASSERT_TRUE(list);
+    EXPECT_EQ(list->status, 200);
+    EXPECT_TRUE(Body(list)["measurements"].empty());
+}
+
+TEST_F(HttpApiTest, MeasureWaitReturnsTheResultAndItIsStored) {
+    auto res = client_->Post("/v1/measure?wait=1", "", "application/json");
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200) << res->body;
+    const json m = Body(res);
+    EXPECT_EQ(m["id"], "m-000001");
+    EXPECT_EQ(m["status"], "ok");
+    EXPECT_DOUBLE_EQ(m["dimensions"]["length_m"].get<double>(), 0.4);
+    EXPECT_TRUE(m["timing_ms"].contains("total"));
+
+    auto last = client_->Get("/v1/measurements/last");
+    ASSERT_TRUE(last);
+    EXPECT_EQ(last->status, 200);
+    EXPECT_EQ(Body(last), m);
+    auto by_id = client_->Get("/v1/measurements/m-000001");
+    ASSERT_TRUE(by_id);
+    EXPECT_EQ(Body(by_id), m);
+    auto cloud = client_->Get("/v1/measurements/m-000001/cloud.ply");
+    ASSERT_TRUE(cloud);
+    EXPECT_EQ(cloud->status, 200);
+    EXPECT_EQ(cloud->body.rfind("ply\n", 0), 0u);
+}
+
+TEST_F(HttpApiTest, MeasureReturns202ThenSecondPostIs409WhileBusy) {
+    station_->hold = true;
+    auto first = client_->Post("/v1/measure", "", "application/json");
+    ASSERT_TRUE(first);
+    ASSERT_EQ(first->status, 202) << first->body;
+    const std::string id = Body(first)["id"];
+    EXPECT_EQ(id, "m-000001");
+    EXPECT_EQ(first->get_header_value("Location"), "/v1/measurements/" + id);
+
+    for (int i = 0; i < 1000 && !station_->in_capture; ++i) std::this_thread::sleep_for(2ms);
+    ExpectError(client_->Post("/v1/measure", "", "application/json"), 409, "BUSY");
+    ExpectError(client_->Post("/v1/measure?wait=1", "", "application/json"), 409, "BUSY");
+
+    // GETs keep answering during the measurement, with its progress.
+    auto status = client_->Get("/v1/status");
+    ASSERT_TRUE(status);
+    const json s = Body(status);
+    EXPECT_EQ(s["state"], "measuring");
+    EXPECT_EQ(s["measurement_id"], id);
+    EXPECT_EQ(s["progress"]["pose"], 1);
+    EXPECT_EQ(s["progress"]["poses"], 4);
+    auto health = client_->Get("/v1/health");
+    ASSERT_TRUE(health);
+    EXPECT_EQ(health->status, 200);
+    ExpectError(client_->Get("/v1/measurements/" + id), 404, "NOT_FOUND");  // not finished
+
+    station_->hold = false;
+    WaitUntilIdle();
+    auto done = client_->Get("/v1/measurements/" + id);
+    ASSERT_TRUE(done);
+    EXPECT_EQ(done->status, 200);
+    EXPECT_EQ(Body(done)["status"], "ok");
+    auto next = client_->Post("/v1/measure", "", "application/json");
+    ASSERT_TRUE(next);
+    EXPECT_EQ(next->status, 202);
+    EXPECT_EQ(Body(next)["id"], "m-000002");
+}
+
+TEST_F(HttpApiTest, HistoryIsNewestFirstWithLimit) {
+    for (int i = 0; i < 3; ++i) {
+        auto res = client_->Post("/v1/measure?wait=1", "", "application/json");
+        ASSERT_TRUE(res);
+        ASSERT_EQ(res->status, 200);
+    }
+    auto list = client_->Get("/v1/measurements?limit=2");
+    ASSERT_TRUE(list);
+    ASSERT_EQ(list->status, 200);
+    const json l = Body(list)["measurements"];
+    ASSERT_EQ(l.size(), 2u);
+    EXPECT_EQ(l[0]["id"], "m-000003");
+    EXPECT_EQ(l[1]["id"], "m-000002");
+    for (const char* bad : {"0", "-1", "abc", "5x", "100000"}) {
+        ExpectError(client_->Get(std::string("/v1/measurements?limit=") + bad), 400, "BAD_REQUEST");
+    }
+}
+
+TEST_F(HttpApiTest, BadRequestsGetTheirCodesAndTheDaemonKeepsServing) {
+    ExpectError(client_->Post("/v1/measure", "{not json", "application/json"), 400, "BAD_REQUEST");
+    ExpectError(client_->Post("/v1/measure", "[1,2]", "application/json"), 400, "BAD_REQUEST");
+    ExpectError(client_->Post("/v1/measure?wait=maybe", "", "application/json"), 400,
+                "BAD_REQUEST");
+    ExpectError(client_->Get("/v1/nope"), 404, "NOT_FOUND");
+    ExpectError(client_->Get("/"), 404, "NOT_FOUND");
+    ExpectError(client_->Delete("/v1/measurements/last"), 404, "NOT_FOUND");
+    ExpectError(client_->Post("/v1/calibrate", "{\"reference_m\": [0.4, 0.3]}", "application/json"),
+                400, "BAD_REQUEST");
+    ExpectError(
+        client_->Post("/v1/calibrate", "{\"reference_m\": [0.4, -0.3, 0.2]}", "application/json"),
+        400, "BAD_REQUEST");
+    ExpectError(client_->Post("/v1/calibrate", "", "application/json"), 400, "BAD_REQUEST");
+    const std::string big(256 * 1024, 'x');
+    ExpectError(client_->Post("/v1/measure", big, "application/json"), 413, "PAYLOAD_TOO_LARGE");
+    EXPECT_FALSE(service_->Busy());  // none of them started a measurement
+
+    auto health = client_->Get("/v1/health");
+    ASSERT_TRUE(health);
+    EXPECT_EQ(health->status, 200);
+    auto ok = client_->Post("/v1/measure?wait=1", "{}", "application/json");
+    ASSERT_TRUE(ok);
+    EXPECT_EQ(ok->status, 200);
+}
+
+TEST_F(HttpApiTest, CalibrateRunsTheStationCalibrationAndReportsRefusals) {
+    auto done =
+        client_->Post("/v1/calibrate", R"({"reference_m": [0.4, 0.3, 0.2]})", "application/json");
+    ASSERT_TRUE(done);
+    ASSERT_EQ(done->status, 200) << done->body;
+    EXPECT_DOUBLE_EQ(Body(done)["reference_m"][2].get<double>(), 0.2);
+    ExpectError(
+        client_->Post("/v1/calibrate", R"({"reference_m": [0.4, 0.3, 1.5]})", "application/json"),
+        422, "WRONG_REFERENCE");
+    EXPECT_EQ(Body(client_->Get("/v1/status"))["last_error"]["code"], "WRONG_REFERENCE");
+    auto calibration = client_->Get("/v1/calibration");
+    ASSERT_TRUE(calibration);
+    EXPECT_EQ(calibration->status, 200);
+    EXPECT_EQ(Body(calibration)["calibrated"], true);
+}
+
+TEST_F(HttpApiTest, WhileCalibratingTheStateSaysSoAndMeasurementsAreRefused) {
+    station_->hold = true;
+    std::thread calibrate([this] {
+        httplib::Client c("127.0.0.1", api_->tcp_port());
+        c.set_read_timeout(20, 0);
+        auto res =
+            c.Post("/v1/calibrate", R"({"reference_m": [0.4, 0.3, 0.2]})", "application/json");
+        EXPECT_TRUE(res && res->status == 200);
+    });
+    for (int i = 0; i < 1000 && !station_->in_capture; ++i) std::this_thread::sleep_for(2ms);
+    const json s = Body(client_->Get("/v1/status"));
+    EXPECT_EQ(s["state"], "calibrating");
+    EXPECT_EQ(s["progress"]["pose"], 2);
+    ExpectError(client_->Post("/v1/measure", "", "application/json"), 409, "BUSY");
+    ExpectError(
+        client_->Post("/v1/calibrate", R"({"reference_m": [0.4, 0.3, 0.2]})", "application/json"),
+        409, "BUSY");
+    station_->hold = false;
+    calibrate.join();
+    EXPECT_EQ(Body(client_->Get("/v1/status"))["state"], "idle");
+}
+
+TEST_F(HttpApiTest, DeviceFailureIsStoredAndShownAsErrorState) {
+    station_->fail_next = true;
+    auto res = client_->Post("/v1/measure?wait=1", "", "application/json");
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200);
+    EXPECT_EQ(Body(res)["status"], "failed");
+    EXPECT_EQ(Body(res)["reason"]["code"], "TURNTABLE_ERROR");
+    auto status = client_->Get("/v1/status");
+    ASSERT_TRUE(status);
+    const json s = Body(status);
+    EXPECT_EQ(s["state"], "error");
+    EXPECT_EQ(s["last_error"]["code"], "TURNTABLE_ERROR");
+    // The next measurement reopens the devices and succeeds.
+    auto again = client_->Post("/v1/measure?wait=1", "", "application/json");
+    ASSERT_TRUE(again);
+    EXPECT_EQ(Body(again)["status"], "ok");
+    EXPECT_EQ(Body(client_->Get("/v1/status"))["state"], "idle");
+}
+
+TEST_F(HttpApiTest, AbortStopsTheTableAndRecordsTheAbortedMeasurement) {
+    station_->hold = true;
+    auto first = client_->Post("/v1/measure", "", "application/json");
+    ASSERT_TRUE(first);
+    ASSERT_EQ(first->status, 202);
+    for (int i = 0; i < 1000 && !station_->in_capture; ++i) std::this_thread::sleep_for(2ms);
+    service_->Abort();
+    service_->Join();
+    EXPECT_EQ(station_->stop_requests, 1);
+    auto m = client_->Get("/v1/measurements/m-000001");
+    ASSERT_TRUE(m);
+    ASSERT_EQ(m->status, 200);
+    EXPECT_EQ(Body(m)["status"], "failed");
+    EXPECT_EQ(Body(m)["reason"]["code"], "ABORTED");
+    ExpectError(client_->Post("/v1/measure", "", "application/json"), 503, "SHUTTING_DOWN");
+}
+
+class HttpApiTokenTest : public HttpApiTest {
+protected:
+    void SetUp() override {
+        ServerConfig config;
+        config.listen = "127.0.0.1:0";
+        config.bearer_token = "s3cret";
+        config.unix_socket = (dir_ / "boxd.sock").string();
+        StartApi(config);
+    }
+};
+
+TEST_F(HttpApiTokenTest, PostsNeedTheBearerTokenGetsDoNot) {
+    ExpectError(client_->Post("/v1/measure", "", "application/json"), 401, "UNAUTHORIZED");
+    httplib::Headers wrong = {{"Authorization", "Bearer s3cre"}};
+    ExpectError(client_->Post("/v1/measure", wrong, "", "application/json"), 401, "UNAUTHORIZED");
+    ExpectError(client_->Post("/v1/calibrate", wrong, "{}", "application/json"), 401,
+                "UNAUTHORIZED");
+    EXPECT_FALSE(service_->Busy());
+    auto status = client_->Get("/v1/status");
+    ASSERT_TRUE(status);
+    EXPECT_EQ(status->status, 200);
+
+    httplib::Headers right = {{"Authorization", "Bearer s3cret"}};
+    auto ok = client_->Post("/v1/measure?wait=1", right, "", "application/json");
+    ASSERT_TRUE(ok);
+    EXPECT_EQ(ok->status, 200) << ok->body;
+}
+
+TEST_F(HttpApiTokenTest, ServesTheUnixSocketToo) {
+    httplib::Client unix_client((dir_ / "boxd.sock").string(), 80);
+    unix_client.set_address_family(AF_UNIX);
+    auto health = unix_client.Get("/v1/health");
+    ASSERT_TRUE(health) << httplib::to_string(health.error());
+    EXPECT_EQ(health->status, 200);
+    httplib::Headers right = {{"Authorization", "Bearer s3cret"}};
+    auto ok = unix_client.Post("/v1/measure?wait=1", right, "", "application/json");
+    ASSERT_TRUE(ok);
+    EXPECT_EQ(ok->status, 200);
+    auto last = client_->Get("/v1/measurements/last");  // and TCP sees the same store
+    ASSERT_TRUE(last);
+    EXPECT_EQ(Body(last)["id"], Body(ok)["id"]);
+}
+
+TEST(HttpApiBind, AnAddressInUseIsAnErrorNamingTheKey) {
+    test::TempDir dir;
+    auto store = MeasurementStore::Open(dir.path(), 5);
+    ASSERT_TRUE(store);
+    MeasurementService service(**store, std::make_shared<ScriptedStation>(), false);
+    ServerConfig config;
+    config.listen = "127.0.0.1:0";
+    HttpApi first(config, service, **store, nullptr);
+    ASSERT_TRUE(first.Start());
+    config.listen = "127.0.0.1:" + std::to_string(first.tcp_port());
+    HttpApi second(config, service, **store, nullptr);
+    Status s = second.Start();
+    ASSERT_FALSE(s);
+    EXPECT_NE(s.error().message.find("server.listen"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace boxd
