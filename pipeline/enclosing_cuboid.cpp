@@ -1,7 +1,11 @@
 #include "pipeline/enclosing_cuboid.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <unordered_map>
 #include <vector>
 
 namespace boxd {
@@ -35,20 +39,39 @@ struct CellStats {
     }
 };
 
-// The largest lower confidence bound over `cells` that hold enough points: how far outside the
-// reference the surface certainly reaches. `se` is that cell's standard error, `judged` the
-// number of cells judged. Returns -inf when no cell is judged.
+// Returns Φ⁻¹(0.5^(1/m)): the median of the largest of m standard normal draws.
+double MedianOfLargest(int m) { return UpperNormalQuantile(1.0 - std::pow(0.5, 1.0 / m)); }
+
+// How far the surface reaches along the cells' axis: the cells whose means could be the largest
+// (within two standard errors of it) compete, and the largest of their means is corrected by the
+// median of the largest of that many noise draws — noise alone then moves the estimate neither
+// out nor in. A flat face has many such cells (a large correction), a tube's tangent few.
+// `se` is the chosen cell's standard error, `judged` the number of cells with enough points.
+// Returns -inf when no cell is judged.
 double LargestBound(const std::vector<CellStats>& cells, const EnvelopeConfig& config, double* se,
                     int* judged) {
     int m = 0;
-    for (const CellStats& c : cells) m += c.n >= config.min_cell_points ? 1 : 0;
-    *judged = m;
-    if (m == 0) return -INFINITY;
-    const double k = UpperNormalQuantile(config.false_alarm / m);
-    double best = -INFINITY;
+    double top = -INFINITY, top_se = 0.0;
     for (const CellStats& c : cells) {
         if (c.n < config.min_cell_points) continue;
-        const double bound = c.Mean() - k * c.StdError();
+        ++m;
+        if (c.Mean() > top) {
+            top = c.Mean();
+            top_se = c.StdError();
+        }
+    }
+    *judged = m;
+    if (m == 0) return -INFINITY;
+    auto competes = [&](const CellStats& c) {
+        return c.n >= config.min_cell_points && c.Mean() >= top - 2.0 * (c.StdError() + top_se);
+    };
+    int contenders = 0;
+    for (const CellStats& c : cells) contenders += competes(c) ? 1 : 0;
+    const double z = MedianOfLargest(contenders);
+    double best = -INFINITY;
+    for (const CellStats& c : cells) {
+        if (!competes(c)) continue;
+        const double bound = c.Mean() - z * c.StdError();
         if (bound > best) {
             best = bound;
             *se = c.StdError();
@@ -79,14 +102,92 @@ struct CellGrid {
 
 struct FaceResult {
     double excess_m = 0.0;
-    double excess_se_m = 0.0;  // standard error of the cell that set the excess
-    double offset_se_m = 0.0;  // standard error of the face plane's offset, from the views
+    double excess_se_m = 0.0;    // standard error of the cell that set the excess
+    double offset_se_m = 0.0;    // standard error of the face plane's offset, from the views
+    double view_spread_m = 0.0;  // standard deviation of the plane's offset between the views
+};
+
+// One face's cells, each with its points' offsets from the face plane kept per view: the views
+// are the independent samples (a view's neighbouring readings share its registration error and
+// its sensor's disparity steps, so its points are not).
+struct FaceCells {
+    int views = 1;
+    std::unordered_map<std::size_t, CellStats> cell_view;  // key cell * views + view
+    std::vector<CellStats> view_plane;                     // per view: offsets near the plane
+
+    FaceResult Evaluate(const EnvelopeConfig& config, double point_sigma,
+                        double agreement_m) const {
+        // Each cell's mean over its views' means, and the views' spread pooled over the face.
+        std::unordered_map<std::size_t, CellStats> cells;
+        for (const auto& [key, st] : cell_view) {
+            if (st.n >= 3) cells[key / static_cast<std::size_t>(views)].Add(st.Mean());
+        }
+        double pooled = 0.0;
+        int dof = 0, total = 0;
+        for (const auto& [cell, st] : cells) {
+            if (st.n >= 2) {
+                pooled += st.sum_sq - st.sum * st.sum / st.n;
+                dof += st.n - 1;
+            }
+        }
+        for (const auto& [key, st] : cell_view) total += st.n;
+        // Without a second view of any cell (one pose), the within-view noise of a cell's mean,
+        // its readings counted as a tenth as many independent ones.
+        const double spread = dof >= 10 ? std::sqrt(pooled / dof) : point_sigma;
+        std::vector<CellStats> judged;
+        std::vector<double> se;
+        for (const auto& [cell, st] : cells) {
+            if (st.n * 3 < config.min_cell_points && dof >= 10) continue;
+            judged.push_back(st);
+            se.push_back(dof >= 10
+                             ? spread / std::sqrt(st.n)
+                             : spread / std::sqrt(std::max(1.0, total / 10.0 / cells.size())));
+        }
+        // The plane's offset as each view sees it: their spread is the registration's and the
+        // noise's contribution to the face's position.
+        CellStats offsets;
+        for (const CellStats& v : view_plane) {
+            if (v.n >= 4 * config.min_cell_points) offsets.Add(v.Mean());
+        }
+        FaceResult out;
+        out.view_spread_m = offsets.n >= 2 ? offsets.StdError() * std::sqrt(offsets.n) : 0.0;
+        out.offset_se_m = offsets.n >= 2
+                              ? offsets.StdError()
+                              : spread / std::sqrt(std::max<std::size_t>(1, cells.size()));
+        // Views that disagree about where the face is (a miscalibrated station, an object that
+        // flexed) make cells stand out that are no surface of the object: a cell must also stand
+        // out beyond the views' spread about the plane.
+        const double threshold =
+            std::max(agreement_m, offsets.n >= 2 ? offsets.StdError() * std::sqrt(offsets.n) : 0.0);
+        // Detection: a cell counts as standing out when its lower bound passes the plane with
+        // the Bonferroni confidence over all the face's cells; the excess is then the largest
+        // mean among those cells, less the median of the largest of that many noise draws.
+        const int m = static_cast<int>(judged.size());
+        if (m > 0) {
+            const double k = UpperNormalQuantile(config.false_alarm / m);
+            int significant = 0;
+            auto stands_out = [&](int i) { return judged[i].Mean() - k * se[i] > threshold; };
+            for (int i = 0; i < m; ++i) significant += stands_out(i) ? 1 : 0;
+            if (significant > 0) {
+                const double z = MedianOfLargest(significant);
+                for (int i = 0; i < m; ++i) {
+                    if (!stands_out(i)) continue;
+                    const double excess = judged[i].Mean() - z * se[i];
+                    if (excess > out.excess_m) {
+                        out.excess_m = excess;
+                        out.excess_se_m = se[i];
+                    }
+                }
+            }
+        }
+        return out;
+    }
 };
 
 // The excess of the 4 side faces and the top of `box` over their fitted planes, and the
 // uncertainty of each plane from the spread of its offset between views.
 std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& box, int views,
-                                        const EnvelopeConfig& config) {
+                                        double agreement_m, const EnvelopeConfig& config) {
     const Eigen::Vector2d a = box.length_axis, b(-a.y(), a.x());
     const double hl = box.length_m / 2.0, hw = box.width_m / 2.0, h = box.height_m;
     const double m = config.edge_margin_m;
@@ -97,52 +198,34 @@ std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& b
         CellGrid(-hl + m, hl - m, m, h - m, config.cell_along_m, config.cell_height_m),
         CellGrid(-hl + m, hl - m, m, h - m, config.cell_along_m, config.cell_height_m),
         CellGrid(-hl + m, hl - m, -hw + m, hw - m, config.cell_along_m, config.cell_along_m)};
-    std::vector<std::array<CellStats, 5>> per_view(static_cast<std::size_t>(std::max(views, 1)));
+    const int nv = std::max(views, 1);
+    std::array<FaceCells, 5> faces;
+    for (FaceCells& f : faces) {
+        f.views = nv;
+        f.view_plane.resize(static_cast<std::size_t>(nv));
+    }
     for (std::size_t i = 0; i < cloud.points.size(); ++i) {
         const Eigen::Vector3f& p3 = cloud.points[i];
         const Eigen::Vector2d q = p3.head<2>().cast<double>() - box.center_m;
         const double u = a.dot(q), v = b.dot(q), z = p3.z();
+        const std::size_t view =
+            i < cloud.view.size() ? std::min<std::size_t>(cloud.view[i], nv - 1) : 0;
         // Offset outside each face, and the face's own coordinates of the point.
         const std::array<double, 5> s = {u - hl, -u - hl, v - hw, -v - hw, z - h};
         const std::array<double, 5> ca = {v, -v, -u, u, u};
         const std::array<double, 5> cb = {z, z, z, z, v};
         for (std::size_t f = 0; f < 5; ++f) {
             if (s[f] < -inward || s[f] > config.outward_band_m) continue;
-            if (CellStats* c = grids[f].At(ca[f], cb[f])) {
-                c->Add(s[f]);
-                const std::size_t view = i < cloud.view.size() ? cloud.view[i] : 0;
-                if (s[f] <= inward && view < per_view.size()) per_view[view][f].Add(s[f]);
-            }
+            CellStats* c = grids[f].At(ca[f], cb[f]);
+            if (c == nullptr) continue;
+            const auto cell = static_cast<std::size_t>(c - grids[f].cells.data());
+            faces[f].cell_view[cell * static_cast<std::size_t>(nv) + view].Add(s[f]);
+            if (s[f] <= inward) faces[f].view_plane[view].Add(s[f]);
         }
     }
     std::array<FaceResult, 5> out;
     for (std::size_t f = 0; f < 5; ++f) {
-        double se = 0.0;
-        int judged = 0;
-        const double bound = LargestBound(grids[f].cells, config, &se, &judged);
-        if (bound > 0.0) {
-            out[f].excess_m = bound;
-            out[f].excess_se_m = se;
-        }
-        // The plane's offset as each view sees it: their spread is the registration's and the
-        // noise's contribution to the face's position.
-        std::vector<double> offsets;
-        int points = 0;
-        for (const auto& v : per_view) {
-            points += v[f].n;
-            if (v[f].n >= 4 * config.min_cell_points) offsets.push_back(v[f].Mean());
-        }
-        if (offsets.size() >= 2) {
-            double mean = 0.0, var = 0.0;
-            for (double o : offsets) mean += o / offsets.size();
-            for (double o : offsets) var += (o - mean) * (o - mean) / (offsets.size() - 1);
-            out[f].offset_se_m = std::sqrt(var / offsets.size());
-        } else {
-            // One view: its noise over the face's cells (neighbouring pixels share their noise
-            // through the lateral jitter, so cells, not points, are the independent samples).
-            out[f].offset_se_m = box.face_sigma_m / std::sqrt(std::max(1, judged));
-        }
-        (void)points;
+        out[f] = faces[f].Evaluate(config, std::max(box.face_sigma_m, 0.0005), agreement_m);
     }
     return out;
 }
@@ -273,19 +356,23 @@ Result<EnclosingCuboid> EnvelopeCuboid(const FusedCloud& cloud, double sigma,
     return c;
 }
 
-// Footprint cells of `cloud` inside the rectangle of `c`, over the rectangle's area.
+// The area of the convex hull of the footprint (points above the table) over the rectangle's:
+// 1 for a box, pi/4 for a tube standing, 7/8 for an L of a quarter cut away. Noise widens the
+// hull by a few millimetres, so the ratio is capped at 1.
 double FillRatio(const FusedCloud& cloud, const EnclosingCuboid& c, const EnvelopeConfig& config) {
-    const Eigen::Vector2d a = c.length_axis, b(-a.y(), a.x());
-    CellGrid grid(-c.length_m / 2.0, c.length_m / 2.0, -c.width_m / 2.0, c.width_m / 2.0,
-                  config.footprint_cell_m, config.footprint_cell_m);
+    std::vector<cv::Point2f> footprint;
+    std::size_t above = 0;
+    for (const Eigen::Vector3f& p : cloud.points) above += p.z() >= config.min_z_m ? 1 : 0;
+    const std::size_t step = std::max<std::size_t>(1, above / config.max_points);
+    std::size_t k = 0;
     for (const Eigen::Vector3f& p : cloud.points) {
-        if (p.z() < config.min_z_m) continue;
-        const Eigen::Vector2d q = p.head<2>().cast<double>() - c.center_m;
-        if (CellStats* cell = grid.At(a.dot(q), b.dot(q))) cell->Add(0.0);
+        if (p.z() < config.min_z_m || (k++ % step) != 0) continue;
+        footprint.emplace_back(p.x(), p.y());
     }
-    int occupied = 0;
-    for (const CellStats& cell : grid.cells) occupied += cell.n >= 2 ? 1 : 0;
-    return static_cast<double>(occupied) / static_cast<double>(grid.cells.size());
+    if (footprint.size() < 3 || c.length_m * c.width_m <= 0.0) return 0.0;
+    std::vector<cv::Point2f> hull;
+    cv::convexHull(footprint, hull);
+    return std::min(1.0, cv::contourArea(hull) / (c.length_m * c.width_m));
 }
 
 }  // namespace
@@ -304,17 +391,19 @@ Status EnvelopeConfig::Validate() const {
     if (directions < 18) return bad("directions", "must be >= 18");
     if (max_points < 1000) return bad("max_points", "must be >= 1000");
     if (!(layer_sigmas > 0.0)) return bad("layer_sigmas", "must be > 0");
-    if (!(footprint_cell_m > 0.0)) return bad("footprint_cell_m", "must be > 0");
     if (!(min_fill > 0.0 && min_fill <= 1.0)) return bad("min_fill", "in (0, 1]");
     if (!(max_relative_excess > 0.0)) return bad("max_relative_excess", "must be > 0");
+    if (!(max_view_spread_rmse > 0.0)) return bad("max_view_spread_rmse", "must be > 0");
     return OkStatus();
 }
 
 Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result<BoxFit>& box,
-                                           int views, const EnvelopeConfig& config) {
+                                           int views, double agreement_m, double noise_sigma_m,
+                                           const EnvelopeConfig& config) {
     if (box) {
         const BoxFit& fit = *box;
-        const std::array<FaceResult, 5> faces = FaceEnvelopes(cloud, fit, views, config);
+        const std::array<FaceResult, 5> faces =
+            FaceEnvelopes(cloud, fit, views, agreement_m, config);
         EnclosingCuboid c;
         for (std::size_t f = 0; f < 5; ++f) c.excess_m[f] = faces[f].excess_m;
         const Eigen::Vector2d a = fit.length_axis, b(-a.y(), a.x());
@@ -342,11 +431,29 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
         const double s_v = std::hypot(face_sigma(2), face_sigma(3));
         c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u, face_sigma(4)};
         c.fill = FillRatio(cloud, c, config);
-        c.cuboid = c.fill >= config.min_fill && c.max_relative_excess <= config.max_relative_excess;
+        // A flat face stands where every view sees it, up to the views' registration; a curved
+        // "face" (a tube's side) stands where each view's tangent is.
+        double spread = 0.0;
+        for (const FaceResult& f : faces) spread = std::max(spread, f.view_spread_m);
+        c.cuboid = c.fill >= config.min_fill &&
+                   c.max_relative_excess <= config.max_relative_excess &&
+                   spread <= config.max_view_spread_rmse * std::max(agreement_m, noise_sigma_m / 4);
+        spdlog::debug(
+            "envelope: face excess {:.2f} {:.2f} {:.2f} {:.2f} top {:.2f} mm (cell se {:.2f} "
+            "{:.2f} "
+            "{:.2f} {:.2f} {:.2f}), plane se {:.2f} {:.2f} {:.2f} {:.2f} {:.2f} mm, fill {:.3f}",
+            faces[0].excess_m * 1e3, faces[1].excess_m * 1e3, faces[2].excess_m * 1e3,
+            faces[3].excess_m * 1e3, faces[4].excess_m * 1e3, faces[0].excess_se_m * 1e3,
+            faces[1].excess_se_m * 1e3, faces[2].excess_se_m * 1e3, faces[3].excess_se_m * 1e3,
+            faces[4].excess_se_m * 1e3, faces[0].offset_se_m * 1e3, faces[1].offset_se_m * 1e3,
+            faces[2].offset_se_m * 1e3, faces[3].offset_se_m * 1e3, faces[4].offset_se_m * 1e3,
+            c.fill);
         if (c.cuboid) return c;
     }
     // No flat faces at right angles: the support function of the surface.
-    const double sigma = box ? std::max(box->face_sigma_m, 0.001) : 0.003;
+    // The outer layer of a cell column is the sensor's noise deep: the noise of the table top
+    // about its plane, seen at about the object's distance.
+    const double sigma = std::max(noise_sigma_m, 0.0005);
     auto c = EnvelopeCuboid(cloud, sigma, config);
     if (!c) return c;
     c->cuboid = false;

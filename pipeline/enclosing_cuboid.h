@@ -30,22 +30,26 @@
 namespace boxd {
 
 struct EnvelopeConfig {
-    double cell_along_m = 0.012;    // cell size along a face (and across the top)
-    double cell_height_m = 0.03;    // cell size up a side face
-    int min_cell_points = 12;       // smaller cells are not judged
-    double false_alarm = 0.05;      // chance that noise alone moves a flat face outwards
-    double edge_margin_m = 0.015;   // points this close to a face's edges belong to no cell of it
+    double cell_along_m = 0.012;      // cell size along a face (and across the top)
+    double cell_height_m = 0.012;     // cell size up a side face
+    int min_cell_points = 12;         // smaller cells are not judged
+    double false_alarm = 0.05;        // chance that noise alone moves a flat face outwards
+    double edge_margin_m = 0.015;     // points this close to a face's edges belong to no cell of it
     double inward_band_sigmas = 3.0;  // a face's points lie from this far inside its plane ...
     double outward_band_m = 0.06;     // ... to this far outside it
     int directions = 180;             // footprint orientations over 180 degrees (irregular)
     int max_points = 40000;           // the support function works on an even subsample
     double layer_sigmas = 5.0;        // a cell's outer layer: within this many σ of its extreme
     double min_z_m = 0.012;           // points lower than this are table, not footprint
-    double footprint_cell_m = 0.01;   // occupancy grid of the fill ratio
-    // Shape: a cuboid's footprint fills its rectangle to at least min_fill, and no face stands
-    // out of its plane by more than max_relative_excess of the box's size across that face.
-    double min_fill = 0.88;
+    // Shape: the convex hull of a cuboid's footprint fills its rectangle to at least min_fill
+    // (an L missing a quarter fills 7/8, a tube pi/4; rounded edges of a tenth of the side lose
+    // a hundredth), and no face stands out of its plane by more than max_relative_excess of the
+    // box's size across that face (a full carton's panel bows out by about 1%).
+    double min_fill = 0.93;
     double max_relative_excess = 0.03;
+    // ... and each face stands where all views see it: their offsets spread by no more than
+    // this many times the registration's RMSE (a tube's side is where each view's tangent is).
+    double max_view_spread_rmse = 3.0;
 
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;
@@ -54,19 +58,24 @@ struct EnvelopeConfig {
 struct EnclosingCuboid {
     double length_m = 0.0;  // footprint side along length_axis, >= width_m
     double width_m = 0.0;
-    double height_m = 0.0;  // above the table top
+    double height_m = 0.0;                               // above the table top
     Eigen::Vector2d center_m = Eigen::Vector2d::Zero();  // footprint centre, table frame
     Eigen::Vector2d length_axis = Eigen::Vector2d::UnitX();
-    bool cuboid = true;                  // flat faces at right angles filling the rectangle
-    double fill = 1.0;                   // footprint area over rectangle area
-    double max_relative_excess = 0.0;    // largest face excess over the box size across it
-    std::array<double, 5> excess_m{};    // +u, -u, +v, -v sides and the top, beyond the faces
-    std::array<double, 3> sigma_m{};     // 1-sigma of length, width, height from the data
+    bool cuboid = true;                // flat faces at right angles filling the rectangle
+    double fill = 1.0;                 // footprint area over rectangle area
+    double max_relative_excess = 0.0;  // largest face excess over the box size across it
+    std::array<double, 5> excess_m{};  // +u, -u, +v, -v sides and the top, beyond the faces
+    std::array<double, 3> sigma_m{};   // 1-sigma of length, width, height from the data
 };
 
-// Returns the smallest enclosing cuboid of `cloud` (table frame), given its face fit `box` (an
-// error when the cloud has no box faces), or INSUFFICIENT_DATA when no surface cell is seen.
+// Returns the smallest enclosing cuboid of `cloud` (table frame, fused from `views` views), given
+// its face fit `box` (an error when the cloud has no box faces), or INSUFFICIENT_DATA when no
+// surface cell is seen. `agreement_m` is how closely the registered views agree (their ICP
+// RMSE): a face cell must stand out of its plane by more than that, beyond its noise, to count —
+// finer structure cannot be told from the fusion's own. `noise_sigma_m` is the sensor's noise
+// per point (the table top's about its fitted plane).
 Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result<BoxFit>& box,
-                                           int views, const EnvelopeConfig& config);
+                                           int views, double agreement_m, double noise_sigma_m,
+                                           const EnvelopeConfig& config);
 
 }  // namespace boxd

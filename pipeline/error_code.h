@@ -42,6 +42,8 @@ enum class ErrorCategory {
     X(kRegistrationFailed, "REGISTRATION_FAILED", kNoDimension)   \
     X(kObjectMoved, "OBJECT_MOVED", kNoDimension)                 \
     X(kInsufficientData, "INSUFFICIENT_DATA", kNoDimension)       \
+    X(kMultipleObjects, "MULTIPLE_OBJECTS", kNoDimension)         \
+    X(kUncertain, "UNCERTAIN", kNoDimension)                      \
     X(kNotCalibrated, "NOT_CALIBRATED", kNoDimension)             \
     X(kTooFewPoses, "TOO_FEW_POSES", kCalibrationRefused)         \
     X(kTableNotVisible, "TABLE_NOT_VISIBLE", kCalibrationRefused) \

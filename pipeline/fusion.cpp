@@ -43,11 +43,15 @@ FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& p
         keys[i] = VoxelKey(all.points[i], inv);
         ++counts[keys[i]];
     }
+    // With fewer than four views most of the surface is seen by a single view, at the fusion
+    // stride about one point per support voxel: the support test would remove the object itself.
+    // Outliers of such sessions are left to the first stage's flying-pixel removal.
+    const int required = views.size() >= 4 ? config.min_support_points : 1;
     FusedCloud out;
     out.points.reserve(all.points.size());
     out.view.reserve(all.points.size());
     for (std::size_t i = 0; i < all.points.size(); ++i) {
-        if (counts[keys[i]] < config.min_support_points) continue;
+        if (counts[keys[i]] < required) continue;
         out.points.push_back(all.points[i]);
         out.view.push_back(all.view[i]);
     }

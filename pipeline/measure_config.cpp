@@ -16,10 +16,10 @@ Status ConfidenceConfig::Validate() const {
 }
 
 Status MeasureConfig::Validate() const {
-    for (Status s :
-         {averaging.Validate(), flying_pixels.Validate(), table_plane.Validate(),
-          segmentation.Validate(), registration.Validate(), pose_graph.Validate(),
-          fusion.Validate(), box_fit.Validate(), refusal.Validate(), confidence.Validate()}) {
+    for (Status s : {averaging.Validate(), flying_pixels.Validate(), table_plane.Validate(),
+                     segmentation.Validate(), registration.Validate(), pose_graph.Validate(),
+                     fusion.Validate(), box_fit.Validate(), envelope.Validate(), refusal.Validate(),
+                     confidence.Validate()}) {
         if (!s) return s;
     }
     if (threads < 1 || threads > 64) {

@@ -3,6 +3,7 @@
 // sections carry the same names), plus the refusal rules and the confidence figure.
 
 #include "pipeline/box_fit.h"
+#include "pipeline/enclosing_cuboid.h"
 #include "pipeline/frame_averaging.h"
 #include "pipeline/fusion.h"
 #include "pipeline/pose_graph.h"
@@ -35,6 +36,7 @@ struct MeasureConfig {
     PoseGraphConfig pose_graph;
     FusionConfig fusion;
     BoxFitConfig box_fit;
+    EnvelopeConfig envelope;
     RefusalConfig refusal;
     ConfidenceConfig confidence;
     int threads = 2;  // for the per-pose stages; registration has its own

@@ -3,8 +3,10 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
+#include "pipeline/enclosing_cuboid.h"
 #include "pipeline/fuse_and_fit.h"
 #include "pipeline/object_views.h"
 #include "pipeline/refusal.h"
@@ -14,6 +16,10 @@
 namespace boxd {
 
 namespace {
+
+// The two-sided 95% quantile of the normal distribution: a 1-sigma uncertainty times this is
+// the 95% bound of SPEC section 5's uncertainty_m.
+constexpr double kCoverage95 = 1.959964;
 
 // The result as the stages fill it in.
 struct Measurement {
@@ -27,7 +33,8 @@ struct Measurement {
         return std::move(out);
     }
 
-    MeasureOutput Measured(const FusedFit& fit, BoxMethod method) {
+    MeasureOutput Measured(const FusedFit& fit, const EnclosingCuboid& cuboid,
+                           const std::array<double, 3>& uncertainty, BoxMethod method) {
         MeasuredDimensions dims;
         dims.method = BoxMethodName(method);
         if (method == BoxMethod::kPca) {
@@ -35,10 +42,13 @@ struct Measurement {
             dims.width_m = fit.pca.extent_m[1];
             dims.height_m = fit.pca.extent_m[2];
         } else {
-            dims.length_m = fit.box->length_m;
-            dims.width_m = fit.box->width_m;
-            dims.height_m = fit.box->height_m;
+            dims.length_m = cuboid.length_m;
+            dims.width_m = cuboid.width_m;
+            dims.height_m = cuboid.height_m;
         }
+        out.result.shape = cuboid.cuboid ? "cuboid" : "irregular";
+        out.result.uncertainty_m =
+            DimensionUncertainty{uncertainty[0], uncertainty[1], uncertainty[2]};
         dims.volume_m3 = dims.length_m * dims.width_m * dims.height_m;
         out.result.status = MeasurementStatus::kOk;
         out.result.dimensions = dims;
@@ -52,14 +62,14 @@ struct Measurement {
 };
 
 // Returns quality.confidence (ConfidenceConfig).
-double Confidence(const RegisteredViews& registered, int poses, const BoxFit& box, long points,
+double Confidence(const RegisteredViews& registered, int poses, double face_sigma_m, long points,
                   const ConfidenceConfig& c) {
     const EdgeStats& edges = registered.edges;
     const double kept = edges.attempted > 0
                             ? static_cast<double>(registered.graph.active_edges) / edges.attempted
                             : (poses == 1 ? c.single_view_share : 0.0);
     return kept * std::exp(-edges.mean_rmse_m / c.rmse_scale_m) *
-           std::exp(-box.face_sigma_m / c.face_sigma_scale_m) *
+           std::exp(-face_sigma_m / c.face_sigma_scale_m) *
            std::min(1.0, static_cast<double>(points) / static_cast<double>(c.full_points));
 }
 
@@ -111,12 +121,28 @@ Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<Prepar
     FusedFit fit =
         FuseAndFit(view_points, registered->poses, config.fusion, config.box_fit, &m.laps);
     quality.points = static_cast<long>(fit.fused.points.size());
-    const auto why = CheckFusedFit(fit, refuse);
+    if (auto why = CheckSingleObject(fit.fused, refuse)) {
+        m.out.cloud = std::move(fit.fused.points);
+        return m.Refused(*why);
+    }
+
+    // 7. The smallest enclosing cuboid of the outermost surface, and the shape.
+    const auto cuboid = FitEnclosingCuboid(fit.fused, fit.box, n, registered->edges.mean_rmse_m,
+                                           table->residual_sigma_m, config.envelope);
+    m.laps.Lap("fit");
+    std::array<double, 3> uncertainty{};
+    if (cuboid) {
+        quality.footprint_fill = cuboid->fill;
+        quality.face_excess_ratio = cuboid->max_relative_excess;
+        for (std::size_t i = 0; i < 3; ++i) uncertainty[i] = kCoverage95 * cuboid->sigma_m[i];
+    }
+    const auto why = CheckEnclosingCuboid(fit, cuboid, uncertainty, refuse);
     m.out.cloud = std::move(fit.fused.points);
     if (why) return m.Refused(*why);
 
-    quality.confidence = Confidence(*registered, n, *fit.box, quality.points, config.confidence);
-    return m.Measured(fit, method);
+    quality.confidence = Confidence(*registered, n, fit.box ? fit.box->face_sigma_m : 0.0,
+                                    quality.points, config.confidence);
+    return m.Measured(fit, *cuboid, uncertainty, method);
 }
 
 Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig& config,

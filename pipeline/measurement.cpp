@@ -67,10 +67,25 @@ json ToJson(const MeasurementResult& m) {
     } else {
         j["obb"] = nullptr;
     }
+    j["shape"] = m.shape.empty() ? json(nullptr) : json(m.shape);
+    if (m.uncertainty_m) {
+        const auto& u = *m.uncertainty_m;
+        j["uncertainty_m"] = {{"length_m", Round(u.length_m, 1e-5)},
+                              {"width_m", Round(u.width_m, 1e-5)},
+                              {"height_m", Round(u.height_m, 1e-5)}};
+    } else {
+        j["uncertainty_m"] = nullptr;
+    }
     j["quality"] = {{"poses", m.quality.poses},
                     {"points", m.quality.points},
                     {"registration_rmse_m", Round(m.quality.registration_rmse_m, 1e-6)},
                     {"confidence", Round(m.quality.confidence, 1e-3)}};
+    if (m.quality.footprint_fill) {
+        j["quality"]["footprint_fill"] = Round(*m.quality.footprint_fill, 1e-3);
+    }
+    if (m.quality.face_excess_ratio) {
+        j["quality"]["face_excess_ratio"] = Round(*m.quality.face_excess_ratio, 1e-4);
+    }
     json timing = json::object();
     for (const auto& [stage, ms] : m.timing_ms) timing[stage] = Round(ms, 0.1);
     j["timing_ms"] = timing;

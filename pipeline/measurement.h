@@ -39,6 +39,17 @@ struct MeasurementQuality {
     long points = 0;
     double registration_rmse_m = 0.0;
     double confidence = 0.0;
+    // The figures that decide `shape` (enclosing_cuboid.h): the footprint's fill of its
+    // rectangle, and the largest outward excess of a face over its plane, relative to the box.
+    std::optional<double> footprint_fill;
+    std::optional<double> face_excess_ratio;
+};
+
+// A 95% bound on each dimension's error, from the data.
+struct DimensionUncertainty {
+    double length_m = 0.0;
+    double width_m = 0.0;
+    double height_m = 0.0;
 };
 
 struct MeasurementResult {
@@ -49,6 +60,8 @@ struct MeasurementResult {
     std::optional<MeasurementReason> reason;
     std::optional<MeasuredDimensions> dimensions;
     std::optional<OrientedBox> obb;
+    std::string shape;                                  // "cuboid" | "irregular" with dimensions
+    std::optional<DimensionUncertainty> uncertainty_m;  // with dimensions
     MeasurementQuality quality;
     std::map<std::string, double> timing_ms;  // stage name -> milliseconds
 };

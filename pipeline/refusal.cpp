@@ -4,6 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <utility>
+#include <vector>
 
 namespace boxd {
 
@@ -38,6 +41,11 @@ Status RefusalConfig::Validate() const {
         return bad("max_model_translation_deviation_m", "must be > 0");
     }
     if (!(max_face_sigma_m > 0.0)) return bad("max_face_sigma_m", "must be > 0");
+    if (!(object_cell_m > 0.0 && object_cell_m < 0.1)) return bad("object_cell_m", "in (0, 0.1)");
+    if (!(min_object_share > 0.0 && min_object_share < 0.5)) {
+        return bad("min_object_share", "must be in (0, 0.5)");
+    }
+    if (!(max_uncertainty_m > 0.0)) return bad("max_uncertainty_m", "must be > 0");
     return OkStatus();
 }
 
@@ -78,8 +86,11 @@ std::optional<MeasurementReason> CheckRegisteredViews(const RegisteredViews& reg
         return Moved(fmt::format("{} of {} view alignments disagree with the others",
                                  report.rejected_edges, edges));
     }
-    if (report.active_edges == 0 ||
-        report.unconstrained_nodes > refuse.max_unconstrained_fraction * poses) {
+    // Views too far apart to share any surface (two or three poses) cannot be aligned, and are
+    // not: their poses rest on the turntable model of the calibrated station.
+    const bool model_only = registered.edges.attempted == 0;
+    if (!model_only && (report.active_edges == 0 ||
+                        report.unconstrained_nodes > refuse.max_unconstrained_fraction * poses)) {
         return MeasurementReason{
             ErrorCode::kRegistrationFailed,
             fmt::format("too few views could be registered ({} of {} unregistered)",
@@ -115,6 +126,87 @@ std::optional<MeasurementReason> CheckFusedFit(const FusedFit& fit, const Refusa
             ErrorCode::kRegistrationFailed,
             fmt::format("the box faces are not flat to {:.0f} mm (sigma {:.1f} mm)",
                         refuse.max_face_sigma_m * 1000.0, box.face_sigma_m * 1000.0)};
+    }
+    return std::nullopt;
+}
+
+std::optional<MeasurementReason> CheckSingleObject(const FusedCloud& fused,
+                                                   const RefusalConfig& refuse) {
+    // Occupied footprint cells above the table, then their 8-connected parts.
+    std::map<std::pair<int, int>, int> cell_part;
+    const double inv = 1.0 / refuse.object_cell_m;
+    for (const Eigen::Vector3f& p : fused.points) {
+        if (p.z() < 2.0 * refuse.object_cell_m) continue;
+        cell_part[{static_cast<int>(std::floor(p.x() * inv)),
+                   static_cast<int>(std::floor(p.y() * inv))}] = -1;
+    }
+    std::vector<int> part_cells;
+    for (auto& [cell, part] : cell_part) {
+        if (part >= 0) continue;
+        const int id = static_cast<int>(part_cells.size());
+        part_cells.push_back(0);
+        std::vector<std::pair<int, int>> stack = {cell};
+        part = id;
+        while (!stack.empty()) {
+            const auto [x, y] = stack.back();
+            stack.pop_back();
+            ++part_cells[static_cast<std::size_t>(id)];
+            for (int dx = -1; dx <= 1; ++dx) {
+                for (int dy = -1; dy <= 1; ++dy) {
+                    auto it = cell_part.find({x + dx, y + dy});
+                    if (it == cell_part.end() || it->second >= 0) continue;
+                    it->second = id;
+                    stack.push_back(it->first);
+                }
+            }
+        }
+    }
+    const double total = static_cast<double>(cell_part.size());
+    int objects = 0;
+    for (int cells : part_cells) objects += cells >= refuse.min_object_share * total ? 1 : 0;
+    if (objects < 2) return std::nullopt;
+    return MeasurementReason{
+        ErrorCode::kMultipleObjects,
+        fmt::format("{} separate objects stand on the table: measure one at a time", objects)};
+}
+
+std::optional<MeasurementReason> CheckEnclosingCuboid(const FusedFit& fit,
+                                                      const Result<EnclosingCuboid>& cuboid,
+                                                      const std::array<double, 3>& uncertainty_m,
+                                                      const RefusalConfig& refuse) {
+    if (static_cast<long>(fit.fused.points.size()) < refuse.min_object_points) {
+        return MeasurementReason{ErrorCode::kNoObject, "nothing stands on the table"};
+    }
+    if (!cuboid) return cuboid.error();
+    const EnclosingCuboid& c = *cuboid;
+    if (std::min(c.width_m, c.height_m) < refuse.min_dimension_m) {
+        return MeasurementReason{
+            ErrorCode::kObjectTooSmall,
+            fmt::format("the object is smaller than {:.0f} mm", refuse.min_dimension_m * 1000.0)};
+    }
+    // A cuboid's faces and views are judged against its box; other shapes have no faces, and
+    // their views are judged by the registration alone.
+    if (c.cuboid && fit.box) {
+        const ConsistencyReport& r = fit.consistency;
+        if (!r.inconsistent_views.empty()) {
+            return Moved(
+                fmt::format("view {} disagrees with the others ({:.0f}% of its points on "
+                            "the box)",
+                            r.worst_view, 100.0 * r.worst_inlier_fraction));
+        }
+        if (fit.box->face_sigma_m > refuse.max_face_sigma_m) {
+            return MeasurementReason{
+                ErrorCode::kRegistrationFailed,
+                fmt::format("the box faces are not flat to {:.0f} mm (sigma {:.1f} mm)",
+                            refuse.max_face_sigma_m * 1000.0, fit.box->face_sigma_m * 1000.0)};
+        }
+    }
+    const double worst = *std::max_element(uncertainty_m.begin(), uncertainty_m.end());
+    if (worst > refuse.max_uncertainty_m) {
+        return MeasurementReason{
+            ErrorCode::kUncertain,
+            fmt::format("a dimension is uncertain by {:.1f} mm (limit {:.1f} mm)", worst * 1000.0,
+                        refuse.max_uncertainty_m * 1000.0)};
     }
     return std::nullopt;
 }

@@ -3,8 +3,10 @@
 // a confident wrong size costs a carrier money, a no_dim costs a re-scan). Every rule the recipe
 // applies is here, in the order the stages reach them; each returns the reason, or nullopt.
 
+#include <array>
 #include <optional>
 
+#include "pipeline/enclosing_cuboid.h"
 #include "pipeline/fuse_and_fit.h"
 #include "pipeline/measurement.h"
 #include "pipeline/object_views.h"
@@ -29,6 +31,12 @@ struct RefusalConfig {
     // Box faces rougher than this (robust sigma of the face fits) are not faces of one rigid box
     // seen from registered views.
     double max_face_sigma_m = 0.01;
+    // Separate objects: footprint cells (of this size, 8-connected) that do not touch form
+    // separate objects; parts holding at least this share of the footprint count as objects.
+    double object_cell_m = 0.01;
+    double min_object_share = 0.05;
+    // A dimension whose 95% uncertainty exceeds this is not reported: UNCERTAIN.
+    double max_uncertainty_m = 0.01;
 
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;
@@ -50,5 +58,19 @@ std::optional<MeasurementReason> CheckRegisteredViews(const RegisteredViews& reg
 // error, OBJECT_TOO_SMALL, OBJECT_MOVED when a view disagrees with the box, REGISTRATION_FAILED
 // when the faces are not flat.
 std::optional<MeasurementReason> CheckFusedFit(const FusedFit& fit, const RefusalConfig& refuse);
+
+// Separate objects on the table: MULTIPLE_OBJECTS when the fused cloud's footprint falls apart
+// into more than one part of substance (no single size describes them).
+std::optional<MeasurementReason> CheckSingleObject(const FusedCloud& fused,
+                                                   const RefusalConfig& refuse);
+
+// The enclosing cuboid of the fused cloud: NO_OBJECT when too few points survive fusion, the
+// envelope's own error, OBJECT_TOO_SMALL; for a cuboid also OBJECT_MOVED when a view disagrees
+// with the box and REGISTRATION_FAILED when its faces are not flat; UNCERTAIN when a dimension's
+// 95% bound `uncertainty_m` exceeds the limit.
+std::optional<MeasurementReason> CheckEnclosingCuboid(const FusedFit& fit,
+                                                      const Result<EnclosingCuboid>& cuboid,
+                                                      const std::array<double, 3>& uncertainty_m,
+                                                      const RefusalConfig& refuse);
 
 }  // namespace boxd

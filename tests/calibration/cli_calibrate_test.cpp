@@ -125,7 +125,7 @@ TEST(CliCalibrate, CalibratesAndTheCalibrationMakesOtherBoxesMeasureRight) {
     EXPECT_NE(yaml.find("\ncalibration:\n  table_center_m: ["), std::string::npos) << yaml;
     EXPECT_NE(yaml.find("depth_offset_m: "), std::string::npos) << yaml;
 
-    // Another box captured at the same station: measured with the calibration it meets +-3 mm;
+    // Another box captured at the same station: measured with the calibration it meets +-2 mm;
     // with the recorded (uncalibrated) values it does not. The measurement pipeline refits the
     // table plane and estimates the turntable centre from the registered views, so the centre
     // and axis errors alone are absorbed; the depth offset is not. A sensor that reads every
@@ -144,12 +144,16 @@ TEST(CliCalibrate, CalibratesAndTheCalibrationMakesOtherBoxesMeasureRight) {
     const std::vector<double> after = Measure(other);
     std::printf("other box: max error %.2f mm uncalibrated, %.2f mm calibrated\n",
                 MaxError(before, truth_dims) * 1e3, MaxError(after, truth_dims) * 1e3);
-    EXPECT_LE(MaxError(after, truth_dims), 0.003);
-    EXPECT_GT(MaxError(before, truth_dims), 0.003);
+    // The product's target for boxes is +-2 mm: calibrated it is met, uncalibrated it is not.
+    // (The uncalibrated cloud is not only small but bent — a depth offset moves each point along
+    // its ray by a fraction that varies over a face — and the enclosing cuboid encloses the bend,
+    // so the uncalibrated box comes out 2-3 mm short rather than the 4-5 mm of its face planes.)
+    EXPECT_LE(MaxError(after, truth_dims), 0.002);
+    EXPECT_GT(MaxError(before, truth_dims), 0.002);
     ASSERT_EQ(before.size(), 3u) << "the uncalibrated station measures, just wrongly";
     // The error is the shrinkage the offset causes, not noise: the box comes out small.
-    EXPECT_LT(before[0], truth_dims[0] - 0.003);
-    EXPECT_LT(before[1], truth_dims[1] - 0.003);
+    EXPECT_LT(before[0], truth_dims[0] - 0.002);
+    EXPECT_LT(before[1], truth_dims[1] - 0.002);
     EXPECT_LT(before[2], truth_dims[2] - 0.001);
 }
 

@@ -48,8 +48,10 @@ TEST(FuseViews, RemovesPointsOfSparselySupportedVoxels) {
          common},
         {turn.Inverse().Apply(common)},
         {shift.Inverse().Apply(common)},
+        {},  // a fourth view: the support test applies from four views on
     };
-    const FusedCloud fused = FuseViews(views, {Se2{}, turn, shift}, config);
+    const std::vector<Se2> poses = {Se2{}, turn, shift, Se2{}};
+    const FusedCloud fused = FuseViews(views, poses, config);
     ASSERT_EQ(fused.points.size(), 3u);
     for (std::size_t i = 0; i < 3; ++i) {
         EXPECT_EQ(fused.view[i], i);
@@ -57,7 +59,16 @@ TEST(FuseViews, RemovesPointsOfSparselySupportedVoxels) {
     }
     // min_support_points = 2 keeps the pair as well, not the lone reading.
     config.min_support_points = 2;
-    EXPECT_EQ(FuseViews(views, {Se2{}, turn, shift}, config).points.size(), 5u);
+    EXPECT_EQ(FuseViews(views, poses, config).points.size(), 5u);
+}
+
+TEST(FuseViews, KeepsEveryReadingOfUpToThreeViews) {
+    // Two or three views see most of the surface once, at the fusion stride about one reading
+    // per support voxel: the support test would remove the object itself.
+    const FusionConfig config;
+    const std::vector<Points> views = {{{0.301f, 0.301f, 0.051f}, {-0.2f, 0.1f, 0.05f}},
+                                       {{0.1f, -0.1f, 0.2f}}};
+    EXPECT_EQ(FuseViews(views, {Se2{}, Se2{}}, config).points.size(), 3u);
 }
 
 // Readings on the +u side face (x = 0.15) of the 0.30 x 0.20 x 0.15 m box of the consistency
