@@ -256,10 +256,12 @@ Result<BoxFit> FitFootprintBox(const Points& points, const BoxFitConfig& config)
     band.fill(config.initial_band_m);
     double top_band = config.initial_band_m;
     std::array<int, 5> counts{};
+    // A top seen only at grazing incidence (a tall box, a camera little above it) has too few
+    // readings to fit: the sides are fitted all the same, at the height of the highest readings,
+    // and the height is left to the enclosing cuboid (where the side faces end).
+    bool top_observed = true;
     for (int it = 0; it < config.iterations; ++it) {
-        if (!FitTop(points, config, top_band, s, counts)) {
-            return Error{ErrorCode::kInsufficientData, "the top face is not observed well enough"};
-        }
+        if (top_observed && !FitTop(points, config, top_band, s, counts)) top_observed = false;
         if (!FitSides(points, config, band, s, counts)) {
             return Error{ErrorCode::kInsufficientData,
                          "a side face of the object is not observed well enough"};
@@ -271,10 +273,9 @@ Result<BoxFit> FitFootprintBox(const Points& points, const BoxFitConfig& config)
         top_band =
             std::clamp(config.band_sigmas * s.sigma[4], config.min_band_m, config.initial_band_m);
     }
-    if (!FitTop(points, config, top_band, s, counts)) {
-        return Error{ErrorCode::kInsufficientData, "the top face is not observed well enough"};
-    }
+    if (top_observed && !FitTop(points, config, top_band, s, counts)) top_observed = false;
     BoxFit fit;
+    fit.top_observed = top_observed;
     const double len_u = s.d[0] + s.d[1], len_v = s.d[2] + s.d[3];
     const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);
     const Eigen::Vector2d nu = FaceNormal(s.yaw, 0), nv = FaceNormal(s.yaw, 2);
@@ -284,7 +285,7 @@ Result<BoxFit> FitFootprintBox(const Points& points, const BoxFitConfig& config)
     fit.length_axis = len_u >= len_v ? nu : nv;
     fit.height_m = s.height;
     fit.face_points = counts;
-    fit.face_sigma_m = *std::max_element(s.sigma.begin(), s.sigma.end());
+    fit.face_sigma_m = *std::max_element(s.sigma.begin(), s.sigma.begin() + (top_observed ? 5 : 4));
     return fit;
 }
 

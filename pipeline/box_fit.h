@@ -38,6 +38,9 @@ struct BoxFit {
     Eigen::Vector2d length_axis = Eigen::Vector2d::UnitX();
     double face_sigma_m = 0.0;         // largest robust sigma of the face fits
     std::array<int, 5> face_points{};  // +u, -u, +v, -v sides and the top
+    // False when the top had too few readings to fit (seen at grazing incidence): height_m is
+    // then only the highest readings', and the sides' own ends say more (enclosing_cuboid.h).
+    bool top_observed = true;
 };
 
 // Returns the footprint box of `points` (table frame, object only): minimal-area rectangle seed,

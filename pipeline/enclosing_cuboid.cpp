@@ -48,22 +48,30 @@ double MedianOfLargest(int m) { return UpperNormalQuantile(1.0 - std::pow(0.5, 1
 // out nor in. A flat face has many such cells (a large correction), a tube's tangent few.
 // `se` is the chosen cell's standard error, `judged` the number of cells with enough points.
 // Returns -inf when no cell is judged.
-double LargestBound(const std::vector<CellStats>& cells, const EnvelopeConfig& config, double* se,
-                    int* judged) {
+double LargestBound(const std::vector<CellStats>& cells, const EnvelopeConfig& config,
+                    double noise_sigma, double* se, int* judged) {
+    // A cell's outer layer is either a surface facing the direction (its readings spread by the
+    // noise alone: the mean is the surface) or a surface running along it, a wall whose end is
+    // the extreme (the readings spread evenly over the layer, plus noise: the end lies √3 extent
+    // standard deviations above the mean). The spread beyond the noise says which, and how much.
+    auto reach = [noise_sigma](const CellStats& c) {
+        const double var = std::max(0.0, (c.sum_sq - c.sum * c.sum / c.n) / std::max(1, c.n - 1));
+        return c.Mean() + std::sqrt(3.0 * std::max(0.0, var - noise_sigma * noise_sigma));
+    };
     int m = 0;
     double top = -INFINITY, top_se = 0.0;
     for (const CellStats& c : cells) {
         if (c.n < config.min_cell_points) continue;
         ++m;
-        if (c.Mean() > top) {
-            top = c.Mean();
+        if (reach(c) > top) {
+            top = reach(c);
             top_se = c.StdError();
         }
     }
     *judged = m;
     if (m == 0) return -INFINITY;
     auto competes = [&](const CellStats& c) {
-        return c.n >= config.min_cell_points && c.Mean() >= top - 2.0 * (c.StdError() + top_se);
+        return c.n >= config.min_cell_points && reach(c) >= top - 2.0 * (c.StdError() + top_se);
     };
     int contenders = 0;
     for (const CellStats& c : cells) contenders += competes(c) ? 1 : 0;
@@ -71,7 +79,7 @@ double LargestBound(const std::vector<CellStats>& cells, const EnvelopeConfig& c
     double best = -INFINITY;
     for (const CellStats& c : cells) {
         if (!competes(c)) continue;
-        const double bound = c.Mean() - z * c.StdError();
+        const double bound = reach(c) - z * c.StdError();
         if (bound > best) {
             best = bound;
             *se = c.StdError();
@@ -267,8 +275,33 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
     }
     Support out;
     int judged = 0;
-    out.forward = LargestBound(front.cells, config, &out.se_forward, &judged);
-    out.backward = LargestBound(back.cells, config, &out.se_backward, &judged);
+    out.forward = LargestBound(front.cells, config, sigma, &out.se_forward, &judged);
+    out.backward = LargestBound(back.cells, config, sigma, &out.se_backward, &judged);
+    return out;
+}
+
+// An even subsample of the cloud above the table (at most config.max_points), and how far it
+// reaches from the axis and up, with a centimetre to spare.
+struct Surface {
+    std::vector<Eigen::Vector3f> points;
+    double radius = 0.0, top = 0.0;
+};
+
+Surface SurfaceAbove(const FusedCloud& cloud, const EnvelopeConfig& config) {
+    Surface out;
+    std::size_t above = 0;
+    for (const Eigen::Vector3f& p : cloud.points) above += p.z() >= config.min_z_m ? 1 : 0;
+    const std::size_t step =
+        std::max<std::size_t>(1, above / static_cast<std::size_t>(config.max_points));
+    std::size_t k = 0;
+    for (const Eigen::Vector3f& p : cloud.points) {
+        if (p.z() < config.min_z_m || (k++ % step) != 0) continue;
+        out.points.push_back(p);
+        out.radius = std::max(out.radius, static_cast<double>(p.head<2>().norm()));
+        out.top = std::max(out.top, static_cast<double>(p.z()));
+    }
+    out.radius += 0.01;
+    out.top += 0.01;
     return out;
 }
 
@@ -291,27 +324,16 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double ra
         }
     }
     int judged = 0;
-    return LargestBound(grid.cells, config, se, &judged);
+    return LargestBound(grid.cells, config, sigma, se, &judged);
 }
 
 // The least-area footprint rectangle of the support function, and the height.
 Result<EnclosingCuboid> EnvelopeCuboid(const FusedCloud& cloud, double sigma,
                                        const EnvelopeConfig& config) {
-    std::vector<Eigen::Vector3f> pts;
-    std::size_t above = 0;
-    for (const Eigen::Vector3f& p : cloud.points) above += p.z() >= config.min_z_m ? 1 : 0;
-    const std::size_t step = std::max<std::size_t>(1, above / config.max_points);
-    double radius = 0.0, top = 0.0;
-    std::size_t k = 0;
-    for (const Eigen::Vector3f& p : cloud.points) {
-        if (p.z() < config.min_z_m || (k++ % step) != 0) continue;
-        pts.push_back(p);
-        radius = std::max(radius, static_cast<double>(p.head<2>().norm()));
-        top = std::max(top, static_cast<double>(p.z()));
-    }
+    const Surface surface = SurfaceAbove(cloud, config);
+    const std::vector<Eigen::Vector3f>& pts = surface.points;
     if (pts.empty()) return Error{ErrorCode::kInsufficientData, "no surface above the table"};
-    radius += 0.01;
-    top += 0.01;
+    const double radius = surface.radius, top = surface.top;
     auto width = [&](double phi, Support* s) {
         *s = SupportAlong(pts, phi, sigma, radius, top, config);
         return s->forward + s->backward;
@@ -361,12 +383,7 @@ Result<EnclosingCuboid> EnvelopeCuboid(const FusedCloud& cloud, double sigma,
 // hull by a few millimetres, so the ratio is capped at 1.
 double FillRatio(const FusedCloud& cloud, const EnclosingCuboid& c, const EnvelopeConfig& config) {
     std::vector<cv::Point2f> footprint;
-    std::size_t above = 0;
-    for (const Eigen::Vector3f& p : cloud.points) above += p.z() >= config.min_z_m ? 1 : 0;
-    const std::size_t step = std::max<std::size_t>(1, above / config.max_points);
-    std::size_t k = 0;
-    for (const Eigen::Vector3f& p : cloud.points) {
-        if (p.z() < config.min_z_m || (k++ % step) != 0) continue;
+    for (const Eigen::Vector3f& p : SurfaceAbove(cloud, config).points) {
         footprint.emplace_back(p.x(), p.y());
     }
     if (footprint.size() < 3 || c.length_m * c.width_m <= 0.0) return 0.0;
@@ -415,6 +432,13 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
         c.width_m = std::min(lu, lv);
         c.length_axis = lu >= lv ? a : b;
         c.height_m = fit.height_m + faces[4].excess_m;
+        double top_se = 0.0;
+        if (!fit.top_observed) {
+            // No top face to fit: the height is where the side faces end.
+            const Surface surface = SurfaceAbove(cloud, config);
+            c.height_m = TopBound(surface.points, std::max(noise_sigma_m, 0.0005), surface.radius,
+                                  config, &top_se);
+        }
         // Each side's excess against the box size across it: the sides against the footprint's
         // other dimension... the face's own span is what a bulge is measured against.
         const std::array<double, 5> span = {fit.width_m, fit.width_m, fit.length_m, fit.length_m,
@@ -429,7 +453,8 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
         };
         const double s_u = std::hypot(face_sigma(0), face_sigma(1));
         const double s_v = std::hypot(face_sigma(2), face_sigma(3));
-        c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u, face_sigma(4)};
+        c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u,
+                     fit.top_observed ? face_sigma(4) : top_se};
         c.fill = FillRatio(cloud, c, config);
         // A flat face stands where every view sees it, up to the views' registration; a curved
         // "face" (a tube's side) stands where each view's tangent is.
