@@ -53,6 +53,14 @@ TEST(CliMeasure, MeasuresABoxAndWritesTheCloud) {
     EXPECT_EQ(j["obb"]["frame"], "table");
     EXPECT_EQ(j["quality"]["poses"], 12);
     EXPECT_GT(j["quality"]["points"].get<long>(), 1000);
+    // SPEC section 5: the shape with its deciding figures, and a 95% bound per dimension.
+    EXPECT_EQ(j["shape"], "cuboid");
+    EXPECT_GT(j["quality"]["footprint_fill"].get<double>(), 0.93);
+    EXPECT_GE(j["quality"]["face_excess_ratio"].get<double>(), 0.0);
+    for (const char* d : {"length_m", "width_m", "height_m"}) {
+        EXPECT_GT(j["uncertainty_m"][d].get<double>(), 0.0) << d;
+        EXPECT_LT(j["uncertainty_m"][d].get<double>(), 0.003) << d;
+    }
     for (const char* stage :
          {"capture", "preprocess", "registration", "optimization", "fusion", "fit", "processing"}) {
         EXPECT_TRUE(j["timing_ms"].contains(stage)) << stage;
@@ -71,6 +79,29 @@ TEST(CliMeasure, MeasuresABoxAndWritesTheCloud) {
     const json pca = Measure(s, 0, {"--method", "pca"});
     EXPECT_EQ(pca["dimensions"]["method"], "pca");
     EXPECT_EQ(pca["obb"], j["obb"]);
+}
+
+TEST(CliMeasure, ATubeIsIrregularAndTwoParcelsAreRefused) {
+    TempDir dir;
+    const auto tube = Synth(
+        dir, "tube", {"--shape", "cylinder", "--dims", "0.16", "0.16", "0.30", "--seed", "4"});
+    const json t = Measure(tube, 0);
+    EXPECT_EQ(t["shape"], "irregular");
+    // The smallest enclosing cuboid of a 160 mm tube, not the 144 mm of its mean "faces".
+    EXPECT_NEAR(t["dimensions"]["length_m"].get<double>(), 0.16, 0.003);
+    EXPECT_NEAR(t["dimensions"]["width_m"].get<double>(), 0.16, 0.003);
+    EXPECT_LT(t["quality"]["footprint_fill"].get<double>(), 0.9);
+
+    const auto two =
+        Synth(dir, "two",
+              {"--dims", "0.25", "0.2", "0.2", "--offset", "-0.1", "0", "--second-dims", "0.12",
+               "0.1", "0.15", "--second-offset", "0.2", "0.1", "--seed", "5"});
+    const json r = Measure(two, 3);
+    EXPECT_EQ(r["status"], "no_dim");
+    EXPECT_EQ(r["reason"]["code"], "MULTIPLE_OBJECTS");
+    EXPECT_TRUE(r["dimensions"].is_null());
+    EXPECT_TRUE(r["shape"].is_null());
+    EXPECT_TRUE(r["uncertainty_m"].is_null());
 }
 
 TEST(CliMeasure, InvalidSessionIsBadInput) {
