@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
+#include <string>
+
 namespace boxd {
 namespace {
 
@@ -129,6 +132,155 @@ TEST(CheckFusedFit, ThinCloudFitErrorSmallObjectMovedViewAndRoughFaces) {
 
     EXPECT_EQ(CheckFusedFit(Fit(0.4, 0.3, 0.2, refuse.max_face_sigma_m * 1.2, 5000), refuse)->code,
               ErrorCode::kRegistrationFailed);
+}
+
+// Appends the sides and the top of the block [x0, x1] x [y0, y1] x [0, h], every 5 mm.
+void AddBlock(FusedCloud& cloud, double x0, double x1, double y0, double y1, double h) {
+    const double step = 0.005;
+    auto put = [&cloud](double x, double y, double z) {
+        cloud.points.emplace_back(static_cast<float>(x), static_cast<float>(y),
+                                  static_cast<float>(z));
+        cloud.view.push_back(0);
+    };
+    for (double z = 0.0; z <= h; z += step) {
+        for (double x = x0; x <= x1; x += step) {
+            put(x, y0, z);
+            put(x, y1, z);
+        }
+        for (double y = y0; y <= y1; y += step) {
+            put(x0, y, z);
+            put(x1, y, z);
+        }
+    }
+    for (double x = x0; x <= x1; x += step) {
+        for (double y = y0; y <= y1; y += step) put(x, y, h);
+    }
+}
+
+TEST(CheckSingleObject, OneBlockIsOneObject) {
+    FusedCloud cloud;
+    AddBlock(cloud, -0.15, 0.15, -0.1, 0.1, 0.2);
+    EXPECT_FALSE(CheckSingleObject(cloud, RefusalConfig{}).has_value());
+}
+
+TEST(CheckSingleObject, TwoSeparateBlocksAreMultipleObjects) {
+    // A 0.3 x 0.2 parcel and a 0.15 x 0.1 one, 5 cm apart (5 empty 1 cm cells between them).
+    FusedCloud cloud;
+    AddBlock(cloud, -0.2, 0.1, -0.1, 0.1, 0.2);
+    AddBlock(cloud, 0.15, 0.3, -0.05, 0.05, 0.15);
+    auto why = CheckSingleObject(cloud, RefusalConfig{});
+    ASSERT_TRUE(why.has_value());
+    EXPECT_EQ(why->code, ErrorCode::kMultipleObjects);
+    EXPECT_NE(why->message.find("2 separate objects"), std::string::npos) << why->message;
+
+    // Blocks that touch (the second against the first's +x face) are one footprint.
+    FusedCloud touching;
+    AddBlock(touching, -0.2, 0.1, -0.1, 0.1, 0.2);
+    AddBlock(touching, 0.1, 0.25, -0.05, 0.05, 0.15);
+    EXPECT_FALSE(CheckSingleObject(touching, RefusalConfig{}).has_value());
+}
+
+TEST(CheckSingleObject, ASpeckBelowTheMinimumShareIsNotAnObject) {
+    // The block's footprint covers 31 x 21 = 651 one-centimetre cells; a 2 x 2 cm speck (a
+    // scrap, a flying pixel cluster) 4 cm beside it holds 9 cells or fewer, under 5%.
+    const RefusalConfig refuse;
+    FusedCloud cloud;
+    AddBlock(cloud, -0.15, 0.15, -0.1, 0.1, 0.2);
+    AddBlock(cloud, 0.19, 0.21, -0.01, 0.01, 0.05);
+    EXPECT_FALSE(CheckSingleObject(cloud, refuse).has_value());
+    // Points lower than two cells (2 cm) are table, not footprint: a flat scrap is no object
+    // however large.
+    FusedCloud flat;
+    AddBlock(flat, -0.15, 0.15, -0.1, 0.1, 0.2);
+    AddBlock(flat, 0.2, 0.35, -0.1, 0.1, 0.015);
+    EXPECT_FALSE(CheckSingleObject(flat, refuse).has_value());
+    // The same speck counts where the share is lowered below it.
+    RefusalConfig strict = refuse;
+    strict.min_object_share = 0.001;
+    auto why = CheckSingleObject(cloud, strict);
+    ASSERT_TRUE(why.has_value());
+    EXPECT_EQ(why->code, ErrorCode::kMultipleObjects);
+}
+
+EnclosingCuboid Cuboid(double l, double w, double h, bool cuboid) {
+    EnclosingCuboid c;
+    c.length_m = l;
+    c.width_m = w;
+    c.height_m = h;
+    c.cuboid = cuboid;
+    c.fill = cuboid ? 1.0 : 0.785;
+    return c;
+}
+
+TEST(CheckEnclosingCuboid, ThinCloudEnvelopeErrorAndSmallObject) {
+    const RefusalConfig refuse;
+    const std::array<double, 3> certain = {0.001, 0.001, 0.001};
+    const FusedFit fit = Fit(0.4, 0.3, 0.2, 0.001, 5000);
+    EXPECT_FALSE(
+        CheckEnclosingCuboid(fit, Cuboid(0.4, 0.3, 0.2, true), certain, refuse).has_value());
+
+    // Too few fused points: NO_OBJECT, whatever the envelope says.
+    const FusedFit thin = Fit(0.4, 0.3, 0.2, 0.001, refuse.min_object_points - 1);
+    EXPECT_EQ(CheckEnclosingCuboid(thin, Cuboid(0.4, 0.3, 0.2, true), certain, refuse)->code,
+              ErrorCode::kNoObject);
+    // The envelope's own error.
+    const Result<EnclosingCuboid> none = Error{ErrorCode::kInsufficientData, "no cells"};
+    EXPECT_EQ(CheckEnclosingCuboid(fit, none, certain, refuse)->code, ErrorCode::kInsufficientData);
+    // The smaller of width and height below 3 cm, for cuboids and other shapes alike.
+    EXPECT_EQ(CheckEnclosingCuboid(fit, Cuboid(0.4, 0.02, 0.2, true), certain, refuse)->code,
+              ErrorCode::kObjectTooSmall);
+    EXPECT_EQ(CheckEnclosingCuboid(fit, Cuboid(0.4, 0.3, 0.025, false), certain, refuse)->code,
+              ErrorCode::kObjectTooSmall);
+    EXPECT_FALSE(
+        CheckEnclosingCuboid(fit, Cuboid(0.4, refuse.min_dimension_m, 0.2, true), certain, refuse)
+            .has_value());
+}
+
+TEST(CheckEnclosingCuboid, UncertainWhenADimensionsBoundExceedsTheLimit) {
+    const RefusalConfig refuse;
+    const FusedFit fit = Fit(0.4, 0.3, 0.2, 0.001, 5000);
+    for (std::size_t i = 0; i < 3; ++i) {
+        std::array<double, 3> u = {0.002, 0.002, 0.002};
+        u[i] = refuse.max_uncertainty_m;  // at the limit: reported
+        EXPECT_FALSE(CheckEnclosingCuboid(fit, Cuboid(0.4, 0.3, 0.2, true), u, refuse).has_value())
+            << i;
+        u[i] = refuse.max_uncertainty_m * 1.2;
+        auto why = CheckEnclosingCuboid(fit, Cuboid(0.4, 0.3, 0.2, true), u, refuse);
+        ASSERT_TRUE(why.has_value()) << i;
+        EXPECT_EQ(why->code, ErrorCode::kUncertain);
+        EXPECT_NE(why->message.find("12.0 mm"), std::string::npos) << why->message;
+        // Irregular shapes are judged the same way.
+        EXPECT_EQ(CheckEnclosingCuboid(fit, Cuboid(0.4, 0.3, 0.2, false), u, refuse)->code,
+                  ErrorCode::kUncertain);
+    }
+}
+
+TEST(CheckEnclosingCuboid, ViewConsistencyAndFlatFacesJudgeCuboidsOnly) {
+    const RefusalConfig refuse;
+    const std::array<double, 3> certain = {0.001, 0.001, 0.001};
+    // A view off the box, and faces rougher than the limit: a tube's side is where each view's
+    // tangent is, so neither says anything about an irregular object.
+    FusedFit off_view = Fit(0.16, 0.16, 0.3, 0.001, 5000);
+    off_view.consistency.inconsistent_views = {4};
+    off_view.consistency.worst_view = 4;
+    off_view.consistency.worst_inlier_fraction = 0.5;
+    const FusedFit rough = Fit(0.16, 0.16, 0.3, refuse.max_face_sigma_m * 1.5, 5000);
+    EXPECT_FALSE(CheckEnclosingCuboid(off_view, Cuboid(0.16, 0.16, 0.3, false), certain, refuse)
+                     .has_value());
+    EXPECT_FALSE(
+        CheckEnclosingCuboid(rough, Cuboid(0.16, 0.16, 0.3, false), certain, refuse).has_value());
+    // The same for a cuboid: OBJECT_MOVED, naming the view, and REGISTRATION_FAILED.
+    auto why = CheckEnclosingCuboid(off_view, Cuboid(0.16, 0.16, 0.3, true), certain, refuse);
+    ASSERT_TRUE(why.has_value());
+    EXPECT_EQ(why->code, ErrorCode::kObjectMoved);
+    EXPECT_NE(why->message.find("view 4"), std::string::npos) << why->message;
+    EXPECT_EQ(CheckEnclosingCuboid(rough, Cuboid(0.16, 0.16, 0.3, true), certain, refuse)->code,
+              ErrorCode::kRegistrationFailed);
+    // Without a box fit there are no faces to judge a cuboid by either.
+    FusedFit no_box = off_view;
+    no_box.box = Error{ErrorCode::kInsufficientData, "no top face"};
+    EXPECT_FALSE(
+        CheckEnclosingCuboid(no_box, Cuboid(0.16, 0.16, 0.3, true), certain, refuse).has_value());
 }
 
 TEST(RefusalConfig, ValidateNamesTheField) {
