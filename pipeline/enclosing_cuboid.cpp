@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
@@ -39,6 +40,26 @@ struct CellStats {
     }
 };
 
+// A cell of an outer layer: the readings' offsets along the direction judged (as CellStats) and
+// their 3-D scatter in (across, up, along) coordinates, which gives the surface's orientation.
+struct LayerCell : CellStats {
+    Eigen::Vector3d sum3 = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();
+    void Add3(double a, double b, double s) {
+        Add(s);
+        const Eigen::Vector3d p(a, b, s);
+        sum3 += p;
+        sum_outer += p * p.transpose();
+    }
+    // Returns |cos| of the angle between the surface's normal and the direction judged.
+    double Facing() const {
+        const Eigen::Vector3d mean = sum3 / n;
+        const Eigen::Matrix3d cov = sum_outer / n - mean * mean.transpose();
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+        return std::abs(eig.eigenvectors().col(0).z());
+    }
+};
+
 // Returns Φ⁻¹(0.5^(1/m)): the median of the largest of m standard normal draws.
 double MedianOfLargest(int m) { return UpperNormalQuantile(1.0 - std::pow(0.5, 1.0 / m)); }
 
@@ -48,19 +69,21 @@ double MedianOfLargest(int m) { return UpperNormalQuantile(1.0 - std::pow(0.5, 1
 // out nor in. A flat face has many such cells (a large correction), a tube's tangent few.
 // `se` is the chosen cell's standard error, `judged` the number of cells with enough points.
 // Returns -inf when no cell is judged.
-double LargestBound(const std::vector<CellStats>& cells, const EnvelopeConfig& config,
+double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
                     double noise_sigma, double* se, int* judged) {
     // A cell's outer layer is either a surface facing the direction (its readings spread by the
     // noise alone: the mean is the surface) or a surface running along it, a wall whose end is
-    // the extreme (the readings spread evenly over the layer, plus noise: the end lies √3 extent
-    // standard deviations above the mean). The spread beyond the noise says which, and how much.
-    auto reach = [noise_sigma](const CellStats& c) {
+    // the extreme: its readings spread evenly over the layer, and the end lies √3 extent standard
+    // deviations (the spread beyond the noise) above their mean. The layer's own 3-D scatter says
+    // which: its normal points along the direction for a facing surface (within 60 degrees).
+    auto reach = [noise_sigma](const LayerCell& c) {
+        if (c.Facing() >= 0.5) return c.Mean();
         const double var = std::max(0.0, (c.sum_sq - c.sum * c.sum / c.n) / std::max(1, c.n - 1));
         return c.Mean() + std::sqrt(3.0 * std::max(0.0, var - noise_sigma * noise_sigma));
     };
     int m = 0;
     double top = -INFINITY, top_se = 0.0;
-    for (const CellStats& c : cells) {
+    for (const LayerCell& c : cells) {
         if (c.n < config.min_cell_points) continue;
         ++m;
         if (reach(c) > top) {
@@ -70,14 +93,14 @@ double LargestBound(const std::vector<CellStats>& cells, const EnvelopeConfig& c
     }
     *judged = m;
     if (m == 0) return -INFINITY;
-    auto competes = [&](const CellStats& c) {
+    auto competes = [&](const LayerCell& c) {
         return c.n >= config.min_cell_points && reach(c) >= top - 2.0 * (c.StdError() + top_se);
     };
     int contenders = 0;
-    for (const CellStats& c : cells) contenders += competes(c) ? 1 : 0;
+    for (const LayerCell& c : cells) contenders += competes(c) ? 1 : 0;
     const double z = MedianOfLargest(contenders);
     double best = -INFINITY;
-    for (const CellStats& c : cells) {
+    for (const LayerCell& c : cells) {
         if (!competes(c)) continue;
         const double bound = reach(c) - z * c.StdError();
         if (bound > best) {
@@ -89,17 +112,18 @@ double LargestBound(const std::vector<CellStats>& cells, const EnvelopeConfig& c
 }
 
 // A dense grid of cells over a rectangle of the (a, b) plane.
+template <typename Cell>
 struct CellGrid {
     double a0, b0, da, db;
     int na, nb;
-    std::vector<CellStats> cells;
+    std::vector<Cell> cells;
     CellGrid(double a_lo, double a_hi, double b_lo, double b_hi, double cell_a, double cell_b)
         : a0(a_lo), b0(b_lo), da(cell_a), db(cell_b) {
         na = std::max(1, static_cast<int>(std::ceil((a_hi - a_lo) / cell_a)));
         nb = std::max(1, static_cast<int>(std::ceil((b_hi - b_lo) / cell_b)));
         cells.resize(static_cast<std::size_t>(na) * static_cast<std::size_t>(nb));
     }
-    CellStats* At(double a, double b) {
+    Cell* At(double a, double b) {
         const int i = static_cast<int>(std::floor((a - a0) / da));
         const int j = static_cast<int>(std::floor((b - b0) / db));
         if (i < 0 || j < 0 || i >= na || j >= nb) return nullptr;
@@ -200,12 +224,13 @@ std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& b
     const double hl = box.length_m / 2.0, hw = box.width_m / 2.0, h = box.height_m;
     const double m = config.edge_margin_m;
     const double inward = std::max(config.inward_band_sigmas * box.face_sigma_m, 0.004);
-    std::array<CellGrid, 5> grids = {
-        CellGrid(-hw + m, hw - m, m, h - m, config.cell_along_m, config.cell_height_m),
-        CellGrid(-hw + m, hw - m, m, h - m, config.cell_along_m, config.cell_height_m),
-        CellGrid(-hl + m, hl - m, m, h - m, config.cell_along_m, config.cell_height_m),
-        CellGrid(-hl + m, hl - m, m, h - m, config.cell_along_m, config.cell_height_m),
-        CellGrid(-hl + m, hl - m, -hw + m, hw - m, config.cell_along_m, config.cell_along_m)};
+    using Grid = CellGrid<CellStats>;
+    std::array<Grid, 5> grids = {
+        Grid(-hw + m, hw - m, m, h - m, config.cell_along_m, config.cell_height_m),
+        Grid(-hw + m, hw - m, m, h - m, config.cell_along_m, config.cell_height_m),
+        Grid(-hl + m, hl - m, m, h - m, config.cell_along_m, config.cell_height_m),
+        Grid(-hl + m, hl - m, m, h - m, config.cell_along_m, config.cell_height_m),
+        Grid(-hl + m, hl - m, -hw + m, hw - m, config.cell_along_m, config.cell_along_m)};
     const int nv = std::max(views, 1);
     std::array<FaceCells, 5> faces;
     for (FaceCells& f : faces) {
@@ -248,15 +273,15 @@ struct Support {
 Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double sigma,
                      double radius, double top, const EnvelopeConfig& config) {
     const Eigen::Vector2d u(std::cos(phi), std::sin(phi)), v(-u.y(), u.x());
-    CellGrid front(-radius, radius, 0.0, top, config.cell_along_m, config.cell_height_m);
-    CellGrid back = front;
+    CellGrid<LayerCell> front(-radius, radius, 0.0, top, config.cell_along_m, config.cell_height_m);
+    CellGrid<LayerCell> back = front;
     std::vector<double> max_s(front.cells.size(), -INFINITY), min_s(front.cells.size(), INFINITY);
-    auto index = [&front](const CellStats* c) {
+    auto index = [&front](const LayerCell* c) {
         return static_cast<std::size_t>(c - front.cells.data());
     };
     for (const Eigen::Vector3f& p : pts) {
         const Eigen::Vector2d q = p.head<2>().cast<double>();
-        if (CellStats* c = front.At(v.dot(q), p.z())) {
+        if (LayerCell* c = front.At(v.dot(q), p.z())) {
             const std::size_t k = index(c);
             const double s = u.dot(q);
             max_s[k] = std::max(max_s[k], s);
@@ -266,12 +291,12 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
     const double layer = config.layer_sigmas * sigma;
     for (const Eigen::Vector3f& p : pts) {
         const Eigen::Vector2d q = p.head<2>().cast<double>();
-        CellStats* c = front.At(v.dot(q), p.z());
+        LayerCell* c = front.At(v.dot(q), p.z());
         if (c == nullptr) continue;
         const std::size_t k = index(c);
-        const double s = u.dot(q);
-        if (s >= max_s[k] - layer) c->Add(s);
-        if (s <= min_s[k] + layer) back.cells[k].Add(-s);
+        const double s = u.dot(q), t = v.dot(q);
+        if (s >= max_s[k] - layer) c->Add3(t, p.z(), s);
+        if (s <= min_s[k] + layer) back.cells[k].Add3(-t, p.z(), -s);
     }
     Support out;
     int judged = 0;
@@ -308,19 +333,19 @@ Surface SurfaceAbove(const FusedCloud& cloud, const EnvelopeConfig& config) {
 // The height: the top's outer layer over (x, y) cells.
 double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double radius,
                 const EnvelopeConfig& config, double* se) {
-    CellGrid grid(-radius, radius, -radius, radius, 2.0 * config.cell_along_m,
-                  2.0 * config.cell_along_m);
+    CellGrid<LayerCell> grid(-radius, radius, -radius, radius, 2.0 * config.cell_along_m,
+                             2.0 * config.cell_along_m);
     std::vector<double> max_z(grid.cells.size(), -INFINITY);
     for (const Eigen::Vector3f& p : pts) {
-        if (CellStats* c = grid.At(p.x(), p.y())) {
+        if (LayerCell* c = grid.At(p.x(), p.y())) {
             const auto k = static_cast<std::size_t>(c - grid.cells.data());
             max_z[k] = std::max(max_z[k], static_cast<double>(p.z()));
         }
     }
     for (const Eigen::Vector3f& p : pts) {
-        if (CellStats* c = grid.At(p.x(), p.y())) {
+        if (LayerCell* c = grid.At(p.x(), p.y())) {
             const auto k = static_cast<std::size_t>(c - grid.cells.data());
-            if (p.z() >= max_z[k] - config.layer_sigmas * sigma) c->Add(p.z());
+            if (p.z() >= max_z[k] - config.layer_sigmas * sigma) c->Add3(p.x(), p.y(), p.z());
         }
     }
     int judged = 0;
