@@ -5,6 +5,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <opencv2/imgproc.hpp>
 #include <unordered_map>
 #include <vector>
@@ -417,6 +418,89 @@ double FillRatio(const FusedCloud& cloud, const EnclosingCuboid& c, const Envelo
     return std::min(1.0, cv::contourArea(hull) / (c.length_m * c.width_m));
 }
 
+// One view: the cuboid assumption. The view shows the top and one or two sides; the faces it
+// does not show are assumed to stand where the top's edges end, so the footprint is the least-
+// area rectangle of the top's readings (every pixel: with nothing to fuse, their edges are the
+// measurement) and the height the top's median. Each edge is then known to about a reading's
+// spacing plus the noise, and that is its uncertainty.
+Result<EnclosingCuboid> SingleViewCuboid(const FusedCloud& cloud, double noise_sigma,
+                                         const EnvelopeConfig& config) {
+    std::vector<float> z;
+    for (const Eigen::Vector3f& p : cloud.points) {
+        if (p.z() >= config.min_z_m) z.push_back(p.z());
+    }
+    if (z.empty()) return Error{ErrorCode::kInsufficientData, "no surface above the table"};
+    const auto q = static_cast<long>(0.995 * static_cast<double>(z.size() - 1));
+    std::nth_element(z.begin(), z.begin() + q, z.end());
+    const double top = z[static_cast<std::size_t>(q)];
+    const double band = std::max(4.0 * noise_sigma, 0.01);
+    std::vector<cv::Point2f> footprint;
+    std::vector<double> heights;
+    for (const Eigen::Vector3f& p : cloud.points) {
+        if (std::abs(p.z() - top) > band) continue;
+        footprint.emplace_back(p.x(), p.y());
+        heights.push_back(p.z());
+    }
+    if (static_cast<int>(footprint.size()) < 10 * config.min_cell_points) {
+        return Error{ErrorCode::kInsufficientData,
+                     "a single view that shows no top face cannot bound the object"};
+    }
+    // Mixed readings at the top's far edge (between the top and the table behind it) lie
+    // beyond the edge, sparsely: the top's footprint is its densely read cells (a cell twice the
+    // readings' spacing holds about four; one holding less than half the typical count is edge
+    // or stray), whose centres span the top to within half a cell at each edge.
+    std::vector<cv::Point2f> raw_hull;
+    cv::convexHull(footprint, raw_hull);
+    const double raw_spacing = std::sqrt(cv::contourArea(raw_hull) / footprint.size());
+    const double cell = std::max(2.0 * raw_spacing, 0.002);
+    std::map<std::pair<int, int>, int> counts;
+    for (const cv::Point2f& p : footprint) {
+        ++counts[{static_cast<int>(std::floor(p.x / cell)),
+                  static_cast<int>(std::floor(p.y / cell))}];
+    }
+    std::vector<int> all_counts;
+    for (const auto& [key, n] : counts) all_counts.push_back(n);
+    std::nth_element(all_counts.begin(),
+                     all_counts.begin() + static_cast<long>(all_counts.size() / 2),
+                     all_counts.end());
+    const int typical = all_counts[all_counts.size() / 2];
+    std::vector<cv::Point2f> dense;
+    for (const auto& [key, n] : counts) {
+        if (2 * n < typical) continue;
+        dense.emplace_back(static_cast<float>((key.first + 0.5) * cell),
+                           static_cast<float>((key.second + 0.5) * cell));
+    }
+    if (dense.size() < 3) {
+        return Error{ErrorCode::kInsufficientData, "the top face is too small to bound the object"};
+    }
+    std::vector<cv::Point2f> hull;
+    cv::convexHull(dense, hull);
+    // The outermost dense cells straddle the edge: their centres stand within half a cell of it,
+    // inside where the cell is mostly top, outside where the edge's mixed readings fill it.
+    const cv::RotatedRect rect = cv::minAreaRect(hull);
+    const double a = rect.size.width, b = rect.size.height;
+    const double angle = rect.angle * M_PI / 180.0;
+    EnclosingCuboid c;
+    c.center_m = Eigen::Vector2d(rect.center.x, rect.center.y);
+    const Eigen::Vector2d axis_a(std::cos(angle), std::sin(angle));
+    c.length_axis = a >= b ? axis_a : Eigen::Vector2d(-axis_a.y(), axis_a.x());
+    c.length_m = std::max(a, b);
+    c.width_m = std::min(a, b);
+    std::nth_element(heights.begin(), heights.begin() + static_cast<long>(heights.size() / 2),
+                     heights.end());
+    c.height_m = heights[heights.size() / 2];
+    // An edge is known to within its cell (uniform over it: sigma cell / √12) and the readings'
+    // spacing (how far the last reading may stand from the true edge).
+    const double spacing = raw_spacing;
+    const double edge = std::hypot(cell / std::sqrt(12.0), spacing);
+    c.sigma_m = {std::sqrt(2.0) * edge, std::sqrt(2.0) * edge,
+                 noise_sigma / std::sqrt(static_cast<double>(heights.size())) + 0.5 * spacing};
+    c.cuboid = true;
+    c.assumed = true;
+    c.fill = std::min(1.0, cv::contourArea(hull) / std::max(a * b, 1e-12));
+    return c;
+}
+
 }  // namespace
 
 Status EnvelopeConfig::Validate() const {
@@ -442,6 +526,7 @@ Status EnvelopeConfig::Validate() const {
 Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result<BoxFit>& box,
                                            int views, double agreement_m, double noise_sigma_m,
                                            const EnvelopeConfig& config) {
+    if (views == 1) return SingleViewCuboid(cloud, std::max(noise_sigma_m, 0.0005), config);
     if (box) {
         const BoxFit& fit = *box;
         const std::array<FaceResult, 5> faces =

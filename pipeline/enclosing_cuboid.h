@@ -19,6 +19,7 @@
 //     least area (h(φ) + h(φ + π)) (h(φ + π/2) + h(φ − π/2)), the height the top's bound.
 // The object is a cuboid when its box fit succeeded, its footprint fills the rectangle and no
 // face stands out of its plane by more than a small fraction of the box.
+//   - One view: the cuboid is assumed (its unseen faces where the top's edges end), and said so.
 
 #include <Eigen/Core>
 #include <array>
@@ -61,8 +62,9 @@ struct EnclosingCuboid {
     double height_m = 0.0;                               // above the table top
     Eigen::Vector2d center_m = Eigen::Vector2d::Zero();  // footprint centre, table frame
     Eigen::Vector2d length_axis = Eigen::Vector2d::UnitX();
-    bool cuboid = true;                // flat faces at right angles filling the rectangle
-    double fill = 1.0;                 // footprint area over rectangle area
+    bool cuboid = true;    // flat faces at right angles filling the rectangle
+    bool assumed = false;  // one view: the faces it does not show are assumed (a cuboid)
+    double fill = 1.0;     // footprint area over rectangle area
     double max_relative_excess = 0.0;  // largest face excess over the box size across it
     std::array<double, 5> excess_m{};  // +u, -u, +v, -v sides and the top, beyond the faces
     std::array<double, 3> sigma_m{};   // 1-sigma of length, width, height from the data

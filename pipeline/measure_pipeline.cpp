@@ -116,7 +116,8 @@ Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<Prepar
     // 5, 6. Fusion and the box fits.
     std::vector<Points> view_points(views.views.size());
     for (std::size_t k = 0; k < view_points.size(); ++k) {
-        view_points[k] = std::move(views.views[k].fusion_points);
+        view_points[k] =
+            n == 1 ? std::move(views.views[k].points) : std::move(views.views[k].fusion_points);
     }
     FusedFit fit =
         FuseAndFit(view_points, registered->poses, config.fusion, config.box_fit, &m.laps);
@@ -134,6 +135,7 @@ Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<Prepar
     if (cuboid) {
         quality.footprint_fill = cuboid->fill;
         quality.face_excess_ratio = cuboid->max_relative_excess;
+        quality.cuboid_assumed = cuboid->assumed;
         for (std::size_t i = 0; i < 3; ++i) uncertainty[i] = kCoverage95 * cuboid->sigma_m[i];
     }
     const auto why = CheckEnclosingCuboid(fit, cuboid, uncertainty, refuse);

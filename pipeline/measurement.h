@@ -43,6 +43,8 @@ struct MeasurementQuality {
     // rectangle, and the largest outward excess of a face over its plane, relative to the box.
     std::optional<double> footprint_fill;
     std::optional<double> face_excess_ratio;
+    // A single view: the faces it does not show were assumed to make a cuboid.
+    bool cuboid_assumed = false;
 };
 
 // A 95% bound on each dimension's error, from the data.

@@ -18,7 +18,9 @@ ObjectViews SegmentObjectViews(const std::vector<DepthMap>& depths, const Camera
         const auto i = static_cast<std::size_t>(k);
         out.views[i] = SegmentView(depths[i], camera, calibration, camera_to_table, segmentation);
         out.clouds[i] = BuildRegistrationClouds(out.views[i].points, coarse_cloud, fine_cloud);
-        out.views[i].points = Points{};
+        // A single view keeps every pixel: with no other view to fuse, its faces' edges are all
+        // the footprint there is, and the fusion stride would cut them short by up to 3 pixels.
+        if (n > 1) out.views[i].points = Points{};
     });
     for (const SegmentedView& v : out.views) {
         out.fusion_points += static_cast<long>(v.fusion_points.size());

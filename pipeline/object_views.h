@@ -12,7 +12,8 @@ namespace boxd {
 
 struct ObjectViews {
     // Per view: the fusion subset of its object points, and its counts. The full-density
-    // `points` are dropped once the registration clouds are built (nothing later needs them).
+    // `points` are dropped once the registration clouds are built (nothing later needs them),
+    // except of a single view (the single-view cuboid of enclosing_cuboid.h measures its edges).
     std::vector<SegmentedView> views;
     std::vector<RegistrationClouds> clouds;  // per view: coarse and fine
     long fusion_points = 0;                  // over all views

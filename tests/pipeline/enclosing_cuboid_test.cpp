@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
 #include <functional>
@@ -346,6 +347,52 @@ TEST(FitEnclosingCuboid, ThinCloudIsInsufficientDataWithoutABox) {
     test::ExpectError(FitEnclosingCuboid(FusedCloud{}, Error{ErrorCode::kObjectTooSmall, "none"},
                                          kViews, kShiftAgreement, kSigma, EnvelopeConfig{}),
                       ErrorCode::kInsufficientData);
+}
+
+TEST(FitEnclosingCuboid, OneViewAssumesACuboidFromTheTopsEdges) {
+    // One view of a 0.40 x 0.30 x 0.25 m box turned by 25 degrees: its top read every 2 mm (a
+    // camera's pixels at about 1 m) with 1.5 mm noise, and the side it faces. The footprint is
+    // the top's extent: known to within a cell of the readings' grid (a few mm), so 5 mm.
+    std::mt19937 rng(7);
+    std::normal_distribution<double> noise(0.0, kSigma);
+    const double l = 0.40, w = 0.30, h = 0.25, yaw = 25.0 * M_PI / 180.0;
+    const Eigen::Rotation2Dd turn(yaw);
+    FusedCloud cloud;
+    auto put = [&](double u, double v, double z) {
+        const Eigen::Vector2d xy = turn * Eigen::Vector2d(u, v);
+        cloud.points.emplace_back(xy.x(), xy.y(), z);
+        cloud.view.push_back(0);
+    };
+    for (double u = -l / 2 + 0.001; u < l / 2; u += 0.002) {
+        for (double v = -w / 2 + 0.001; v < w / 2; v += 0.002) put(u, v, h + noise(rng));
+    }
+    for (double u = -l / 2 + 0.001; u < l / 2; u += 0.002) {
+        for (double z = 0.013; z < h; z += 0.002) put(u, -w / 2 + noise(rng), z);
+    }
+    const auto c = FitEnclosingCuboid(cloud, FitFootprintBox(cloud.points, BoxFitConfig{}), 1, 0.0,
+                                      kSigma, EnvelopeConfig{});
+    ASSERT_TRUE(c.ok()) << c.error().message;
+    EXPECT_TRUE(c->assumed);
+    EXPECT_TRUE(c->cuboid);
+    EXPECT_NEAR(c->length_m, l, 0.005);
+    EXPECT_NEAR(c->width_m, w, 0.005);
+    EXPECT_NEAR(c->height_m, h, 0.001);
+    // Its uncertainty is the edges': millimetres, not the face fits' tenths.
+    EXPECT_GT(c->sigma_m[0], 0.001);
+    EXPECT_LT(c->sigma_m[0], 0.005);
+
+    // A single view without a top (only the side) cannot bound the object.
+    FusedCloud side;
+    for (std::size_t i = 0; i < cloud.points.size(); ++i) {
+        if (cloud.points[i].z() < h - 0.02) {
+            side.points.push_back(cloud.points[i]);
+            side.view.push_back(0);
+        }
+    }
+    const auto none = FitEnclosingCuboid(side, FitFootprintBox(side.points, BoxFitConfig{}), 1, 0.0,
+                                         kSigma, EnvelopeConfig{});
+    ASSERT_TRUE(none.ok());          // the side's own top edge reads as a (narrow) top ...
+    EXPECT_LT(none->width_m, 0.05);  // ... and measures as the thin wall it is, never as the box
 }
 
 TEST(EnvelopeConfig, ValidateNamesTheField) {
