@@ -77,10 +77,16 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
     // the extreme: its readings spread evenly over the layer, and the end lies √3 extent standard
     // deviations (the spread beyond the noise) above their mean. The layer's own 3-D scatter says
     // which: its normal points along the direction for a facing surface (within 60 degrees).
+    // The spread must also exceed the noise by more than a sample variance wanders (three of
+    // its standard errors, σ² √(2 / (n − 1))), or noise in a facing cell would pass for a wall.
     auto reach = [noise_sigma](const LayerCell& c) {
-        if (c.Facing() >= 0.5) return c.Mean();
         const double var = std::max(0.0, (c.sum_sq - c.sum * c.sum / c.n) / std::max(1, c.n - 1));
-        return c.Mean() + std::sqrt(3.0 * std::max(0.0, var - noise_sigma * noise_sigma));
+        const double noise_var = noise_sigma * noise_sigma;
+        const double excess_var = var - noise_var;
+        if (c.Facing() >= 0.5 || excess_var <= 3.0 * noise_var * std::sqrt(2.0 / (c.n - 1))) {
+            return c.Mean();
+        }
+        return c.Mean() + std::sqrt(3.0 * excess_var);
     };
     int m = 0;
     double top = -INFINITY, top_se = 0.0;
@@ -404,18 +410,49 @@ Result<EnclosingCuboid> EnvelopeCuboid(const FusedCloud& cloud, double sigma,
     return c;
 }
 
-// The area of the convex hull of the footprint (points above the table) over the rectangle's:
-// 1 for a box, pi/4 for a tube standing, 7/8 for an L of a quarter cut away. Noise widens the
-// hull by a few millimetres, so the ratio is capped at 1.
-double FillRatio(const FusedCloud& cloud, const EnclosingCuboid& c, const EnvelopeConfig& config) {
-    std::vector<cv::Point2f> footprint;
-    for (const Eigen::Vector3f& p : SurfaceAbove(cloud, config).points) {
-        footprint.emplace_back(p.x(), p.y());
+// Returns the area of the convex hull of the centres of the cells (of `cell` metres) that hold
+// at least `min_points` of `points`.
+double CellHullArea(const std::vector<Eigen::Vector2d>& points, double cell, int min_points) {
+    std::map<std::pair<int, int>, int> counts;
+    for (const Eigen::Vector2d& p : points) {
+        ++counts[{static_cast<int>(std::floor(p.x() / cell)),
+                  static_cast<int>(std::floor(p.y() / cell))}];
     }
-    if (footprint.size() < 3 || c.length_m * c.width_m <= 0.0) return 0.0;
+    std::vector<cv::Point2f> centres;
+    for (const auto& [key, n] : counts) {
+        if (n < min_points) continue;
+        centres.emplace_back(static_cast<float>((key.first + 0.5) * cell),
+                             static_cast<float>((key.second + 0.5) * cell));
+    }
+    if (centres.size() < 3) return 0.0;
     std::vector<cv::Point2f> hull;
-    cv::convexHull(footprint, hull);
-    return std::min(1.0, cv::contourArea(hull) / (c.length_m * c.width_m));
+    cv::convexHull(centres, hull);
+    return cv::contourArea(hull);
+}
+
+// The area of the convex hull of the footprint over the rectangle's: 1 for a box, pi/4 for a
+// tube standing, 7/8 for an L of a quarter cut away. Noise scatters single readings a few sigma
+// beyond the surface, and a hull of readings would grow by that all round; the hull is therefore
+// taken of the footprint cells that hold several readings (scattered readings rarely share a
+// cell), and compared with the same hull of the rectangle itself, filled and cut into the same
+// cells, so that the cells' own coarseness cancels.
+double FillRatio(const FusedCloud& cloud, const EnclosingCuboid& c, const EnvelopeConfig& config) {
+    const double cell = config.fill_cell_m;
+    std::vector<Eigen::Vector2d> footprint;
+    for (const Eigen::Vector3f& p : SurfaceAbove(cloud, config).points) {
+        footprint.push_back(p.head<2>().cast<double>());
+    }
+    const Eigen::Vector2d a = c.length_axis, b(-a.y(), a.x());
+    std::vector<Eigen::Vector2d> rectangle;
+    const double step = cell / 4.0;
+    for (double u = -c.length_m / 2.0 + step / 2.0; u < c.length_m / 2.0; u += step) {
+        for (double v = -c.width_m / 2.0 + step / 2.0; v < c.width_m / 2.0; v += step) {
+            rectangle.push_back(c.center_m + u * a + v * b);
+        }
+    }
+    const double reference = CellHullArea(rectangle, cell, 1);
+    if (reference <= 0.0) return 0.0;
+    return std::min(1.0, CellHullArea(footprint, cell, config.fill_cell_points) / reference);
 }
 
 // One view: the cuboid assumption. The view shows the top and one or two sides; the faces it
@@ -518,6 +555,8 @@ Status EnvelopeConfig::Validate() const {
     if (max_points < 1000) return bad("max_points", "must be >= 1000");
     if (!(layer_sigmas > 0.0)) return bad("layer_sigmas", "must be > 0");
     if (!(min_fill > 0.0 && min_fill <= 1.0)) return bad("min_fill", "in (0, 1]");
+    if (!(fill_cell_m > 0.0 && fill_cell_m < 0.05)) return bad("fill_cell_m", "in (0, 0.05)");
+    if (fill_cell_points < 1) return bad("fill_cell_points", "must be >= 1");
     if (!(max_relative_excess > 0.0)) return bad("max_relative_excess", "must be > 0");
     if (!(max_view_spread_rmse > 0.0)) return bad("max_view_spread_rmse", "must be > 0");
     return OkStatus();

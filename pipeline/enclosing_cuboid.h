@@ -47,6 +47,8 @@ struct EnvelopeConfig {
     // a hundredth), and no face stands out of its plane by more than max_relative_excess of the
     // box's size across that face (a full carton's panel bows out by about 1%).
     double min_fill = 0.93;
+    double fill_cell_m = 0.01;  // footprint cells of the fill's hull ...
+    int fill_cell_points = 3;   // ... holding at least this many readings
     double max_relative_excess = 0.03;
     // ... and each face stands where all views see it: their offsets spread by no more than
     // this many times the registration's RMSE (a tube's side is where each view's tangent is).

@@ -307,16 +307,15 @@ TEST(FitEnclosingCuboid, LShapeIsIrregularAndBoundedByItsBoundingBox) {
 }
 
 TEST(FitEnclosingCuboid, LShapeIsIrregularAtTwoAndAHalfMillimetresOfNoise) {
-    GTEST_SKIP() << "limitation: the hull of noisy points grows by ~3.5 sigma all round, so the "
-                    "L's fill 7/8 reads 0.941 at sigma 2 mm, 0.959 at 2.5 mm (>= min_fill 0.93)";
     const double l = 0.40, w = 0.30, h = 0.20, sigma = 0.0025;
     const std::vector<Block> blocks = {{-l / 2, l / 2, -w / 2, 0.0, h},
                                        {-l / 2, 0.0, 0.0, w / 2, h}};
     const Fitted f = Fit(SampleBlocks(blocks, 0.0, 0.7, {-0.01, 0.0}, 4, sigma), sigma);
     ASSERT_TRUE(f.cuboid.ok()) << f.cuboid.error().message;
     EXPECT_FALSE(f.cuboid->cuboid) << "fill " << f.cuboid->fill;
-    EXPECT_NEAR(f.cuboid->length_m, l, 0.002);
-    EXPECT_NEAR(f.cuboid->width_m, w, 0.002);
+    // The support function at 2.5 mm of noise: within the +-3 mm of irregular shapes.
+    EXPECT_NEAR(f.cuboid->length_m, l, 0.003);
+    EXPECT_NEAR(f.cuboid->width_m, w, 0.003);
 }
 
 TEST(FitEnclosingCuboid, ThinCloudIsInsufficientDataWithoutABox) {
