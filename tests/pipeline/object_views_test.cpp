@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "pipeline/view_registration.h"
+#include "tests/support/down_camera.h"
 
 namespace boxd {
 namespace {
@@ -14,23 +15,9 @@ namespace {
 // pixel spans 12 mm at 0.9 m, enough for registration clouds of a few hundred points.
 constexpr double kCameraHeight = 1.0;
 
-CameraIntrinsics DownCamera() {
-    CameraIntrinsics cam;
-    cam.width = 96;
-    cam.height = 72;
-    cam.fx = 75.0;
-    cam.fy = 75.0;
-    cam.cx = 47.5;
-    cam.cy = 35.5;
-    return cam;
-}
+CameraIntrinsics DownCamera() { return test::DownCamera(96, 72, 75.0); }
 
-Eigen::Isometry3d LookingDown() {
-    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-    t.linear() = Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
-    t.translation() = Eigen::Vector3d(0.0, 0.0, kCameraHeight);
-    return t;
-}
+Eigen::Isometry3d LookingDown() { return test::LookingDown(kCameraHeight); }
 
 // The bare table, with the box top `height` above it over pixels [u0, u1) x [v0, v1) when
 // height > 0.

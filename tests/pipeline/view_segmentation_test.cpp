@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "tests/support/down_camera.h"
+
 namespace boxd {
 namespace {
 
@@ -12,23 +14,9 @@ namespace {
 // is the table point ((u - cx) / fx * z, -(v - cy) / fy * z, kCameraHeight - z).
 constexpr double kCameraHeight = 1.0;
 
-CameraIntrinsics SmallCamera() {
-    CameraIntrinsics cam;
-    cam.width = 64;
-    cam.height = 48;
-    cam.fx = 50.0;
-    cam.fy = 50.0;
-    cam.cx = 31.5;
-    cam.cy = 23.5;
-    return cam;
-}
+CameraIntrinsics SmallCamera() { return test::DownCamera(64, 48, 50.0); }
 
-Eigen::Isometry3d LookingDown() {
-    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-    t.linear() = Eigen::Vector3d(1.0, -1.0, -1.0).asDiagonal();
-    t.translation() = Eigen::Vector3d(0.0, 0.0, kCameraHeight);
-    return t;
-}
+Eigen::Isometry3d LookingDown() { return test::LookingDown(kCameraHeight); }
 
 // The bare table top: every pixel reads the camera height.
 DepthMap Table(const CameraIntrinsics& cam) {
