@@ -478,7 +478,25 @@ Result<EnclosingCuboid> SingleViewCuboid(const FusedCloud& cloud, double noise_s
         footprint.emplace_back(p.x(), p.y());
         heights.push_back(p.z());
     }
-    if (static_cast<int>(footprint.size()) < 10 * config.min_cell_points) {
+    // The highest readings must be a top: a horizontal surface, not the upper strip of a wall.
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+    for (std::size_t i = 0; i < footprint.size(); ++i) {
+        const Eigen::Vector3d p(footprint[i].x, footprint[i].y, heights[i]);
+        mean += p;
+        outer += p * p.transpose();
+    }
+    bool horizontal = false;
+    if (!footprint.empty()) {
+        mean /= static_cast<double>(footprint.size());
+        const Eigen::Matrix3d cov =
+            outer / static_cast<double>(footprint.size()) - mean * mean.transpose();
+        horizontal =
+            std::abs(
+                Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0).z()) >
+            std::cos(M_PI / 6.0);
+    }
+    if (static_cast<int>(footprint.size()) < 10 * config.min_cell_points || !horizontal) {
         return Error{ErrorCode::kInsufficientData,
                      "a single view that shows no top face cannot bound the object"};
     }

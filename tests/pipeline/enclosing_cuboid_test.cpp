@@ -388,10 +388,10 @@ TEST(FitEnclosingCuboid, OneViewAssumesACuboidFromTheTopsEdges) {
             side.view.push_back(0);
         }
     }
-    const auto none = FitEnclosingCuboid(side, FitFootprintBox(side.points, BoxFitConfig{}), 1, 0.0,
-                                         kSigma, EnvelopeConfig{});
-    ASSERT_TRUE(none.ok());          // the side's own top edge reads as a (narrow) top ...
-    EXPECT_LT(none->width_m, 0.05);  // ... and measures as the thin wall it is, never as the box
+    // (Its highest readings are the wall's upper strip: a vertical surface, not a top.)
+    test::ExpectError(FitEnclosingCuboid(side, FitFootprintBox(side.points, BoxFitConfig{}), 1, 0.0,
+                                         kSigma, EnvelopeConfig{}),
+                      ErrorCode::kInsufficientData);
 }
 
 TEST(EnvelopeConfig, ValidateNamesTheField) {
