@@ -1,0 +1,137 @@
+#include "pipeline/face_envelope.h"
+
+#include <algorithm>
+#include <unordered_map>
+#include <vector>
+
+#include "pipeline/surface_cells.h"
+
+namespace boxd::envelope {
+
+namespace {
+
+// One face's cells, each with its points' offsets from the face plane kept per view: the views
+// are the independent samples (a view's neighbouring readings share its registration error and
+// its sensor's disparity steps, so its points are not).
+struct FaceCells {
+    int views = 1;
+    std::unordered_map<std::size_t, CellStats> cell_view;  // key cell * views + view
+    std::vector<CellStats> view_plane;                     // per view: offsets near the plane
+
+    FaceResult Evaluate(const EnvelopeConfig& config, double point_sigma,
+                        double agreement_m) const {
+        // Each cell's mean over its views' means, and the views' spread pooled over the face.
+        std::unordered_map<std::size_t, CellStats> cells;
+        for (const auto& [key, st] : cell_view) {
+            if (st.n >= 3) cells[key / static_cast<std::size_t>(views)].Add(st.Mean());
+        }
+        double pooled = 0.0;
+        int dof = 0, total = 0;
+        for (const auto& [cell, st] : cells) {
+            if (st.n >= 2) {
+                pooled += st.sum_sq - st.sum * st.sum / st.n;
+                dof += st.n - 1;
+            }
+        }
+        for (const auto& [key, st] : cell_view) total += st.n;
+        // Without a second view of any cell (one pose), the within-view noise of a cell's mean,
+        // its readings counted as a tenth as many independent ones.
+        const double spread = dof >= 10 ? std::sqrt(pooled / dof) : point_sigma;
+        std::vector<CellStats> judged;
+        std::vector<double> se;
+        for (const auto& [cell, st] : cells) {
+            if (st.n * 3 < config.min_cell_points && dof >= 10) continue;
+            judged.push_back(st);
+            se.push_back(dof >= 10
+                             ? spread / std::sqrt(st.n)
+                             : spread / std::sqrt(std::max(1.0, total / 10.0 / cells.size())));
+        }
+        // The plane's offset as each view sees it: their spread is the registration's and the
+        // noise's contribution to the face's position.
+        CellStats offsets;
+        for (const CellStats& v : view_plane) {
+            if (v.n >= 4 * config.min_cell_points) offsets.Add(v.Mean());
+        }
+        FaceResult out;
+        out.view_spread_m = offsets.n >= 2 ? offsets.StdError() * std::sqrt(offsets.n) : 0.0;
+        out.offset_se_m = offsets.n >= 2
+                              ? offsets.StdError()
+                              : spread / std::sqrt(std::max<std::size_t>(1, cells.size()));
+        // Views that disagree about where the face is (a miscalibrated station, an object that
+        // flexed) make cells stand out that are no surface of the object: a cell must also stand
+        // out beyond the views' spread about the plane.
+        const double threshold =
+            std::max(agreement_m, offsets.n >= 2 ? offsets.StdError() * std::sqrt(offsets.n) : 0.0);
+        // Detection: a cell counts as standing out when its lower bound passes the plane with
+        // the Bonferroni confidence over all the face's cells; the excess is then the largest
+        // mean among those cells, less the median of the largest of that many noise draws.
+        const int m = static_cast<int>(judged.size());
+        if (m > 0) {
+            const double k = UpperNormalQuantile(config.false_alarm / m);
+            int significant = 0;
+            auto stands_out = [&](int i) { return judged[i].Mean() - k * se[i] > threshold; };
+            for (int i = 0; i < m; ++i) significant += stands_out(i) ? 1 : 0;
+            if (significant > 0) {
+                const double z = MedianOfLargest(significant);
+                for (int i = 0; i < m; ++i) {
+                    if (!stands_out(i)) continue;
+                    const double excess = judged[i].Mean() - z * se[i];
+                    if (excess > out.excess_m) {
+                        out.excess_m = excess;
+                        out.excess_se_m = se[i];
+                    }
+                }
+            }
+        }
+        return out;
+    }
+};
+
+}  // namespace
+
+std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& box, int views,
+                                        double agreement_m, const EnvelopeConfig& config) {
+    const Eigen::Vector2d a = box.length_axis, b(-a.y(), a.x());
+    const double hl = box.length_m / 2.0, hw = box.width_m / 2.0, h = box.height_m;
+    const double m = config.edge_margin_m;
+    const double inward = std::max(config.inward_band_sigmas * box.face_sigma_m, 0.004);
+    using Grid = CellGrid<CellStats>;
+    std::array<Grid, 5> grids = {
+        Grid(-hw + m, hw - m, m, h - m, config.cell_along_m, config.cell_height_m),
+        Grid(-hw + m, hw - m, m, h - m, config.cell_along_m, config.cell_height_m),
+        Grid(-hl + m, hl - m, m, h - m, config.cell_along_m, config.cell_height_m),
+        Grid(-hl + m, hl - m, m, h - m, config.cell_along_m, config.cell_height_m),
+        Grid(-hl + m, hl - m, -hw + m, hw - m, config.cell_along_m, config.cell_along_m)};
+    const int nv = std::max(views, 1);
+    std::array<FaceCells, 5> faces;
+    for (FaceCells& f : faces) {
+        f.views = nv;
+        f.view_plane.resize(static_cast<std::size_t>(nv));
+    }
+    for (std::size_t i = 0; i < cloud.points.size(); ++i) {
+        const Eigen::Vector3f& p3 = cloud.points[i];
+        const Eigen::Vector2d q = p3.head<2>().cast<double>() - box.center_m;
+        const double u = a.dot(q), v = b.dot(q), z = p3.z();
+        const std::size_t view =
+            i < cloud.view.size() ? std::min<std::size_t>(cloud.view[i], nv - 1) : 0;
+        // Offset outside each face, and the face's own coordinates of the point.
+        const std::array<double, 5> s = {u - hl, -u - hl, v - hw, -v - hw, z - h};
+        const std::array<double, 5> ca = {v, -v, -u, u, u};
+        const std::array<double, 5> cb = {z, z, z, z, v};
+        for (std::size_t f = 0; f < 5; ++f) {
+            if (s[f] < -inward || s[f] > config.outward_band_m) continue;
+            CellStats* c = grids[f].At(ca[f], cb[f]);
+            if (c == nullptr) continue;
+            const auto cell = static_cast<std::size_t>(c - grids[f].cells.data());
+            faces[f].cell_view[cell * static_cast<std::size_t>(nv) + view].Add(s[f]);
+            if (s[f] <= inward) faces[f].view_plane[view].Add(s[f]);
+        }
+    }
+    std::array<FaceResult, 5> out;
+    for (std::size_t f = 0; f < 5; ++f) {
+        out[f] = faces[f].Evaluate(config, std::max(box.face_sigma_m, 0.0005), agreement_m);
+    }
+    return out;
+}
+
+}  // namespace boxd::envelope

@@ -1,0 +1,26 @@
+#pragma once
+// The faces of a fitted box, cell by cell: how far each of its 4 sides and its top stands out
+// of its fitted plane (a bulge, a strap, a label), and how well its plane is known from the
+// views. The cuboid half of the enclosing cuboid (enclosing_cuboid.h).
+
+#include <array>
+
+#include "pipeline/box_fit.h"
+#include "pipeline/enclosing_cuboid.h"
+#include "pipeline/fusion.h"
+
+namespace boxd::envelope {
+
+struct FaceResult {
+    double excess_m = 0.0;
+    double excess_se_m = 0.0;    // standard error of the cell that set the excess
+    double offset_se_m = 0.0;    // standard error of the face plane's offset, from the views
+    double view_spread_m = 0.0;  // standard deviation of the plane's offset between the views
+};
+
+// The excess of the 4 side faces and the top of `box` over their fitted planes, and the
+// uncertainty of each plane from the spread of its offset between views.
+std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& box, int views,
+                                        double agreement_m, const EnvelopeConfig& config);
+
+}  // namespace boxd::envelope

@@ -1,0 +1,109 @@
+#include "pipeline/single_view_cuboid.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <utility>
+#include <vector>
+
+#include "pipeline/surface_cells.h"
+
+namespace boxd::envelope {
+
+Result<EnclosingCuboid> SingleViewCuboid(const FusedCloud& cloud, double noise_sigma,
+                                         const EnvelopeConfig& config) {
+    std::vector<float> z;
+    for (const Eigen::Vector3f& p : cloud.points) {
+        if (p.z() >= config.min_z_m) z.push_back(p.z());
+    }
+    if (z.empty()) return Error{ErrorCode::kInsufficientData, "no surface above the table"};
+    const auto q = static_cast<long>(0.995 * static_cast<double>(z.size() - 1));
+    std::nth_element(z.begin(), z.begin() + q, z.end());
+    const double top = z[static_cast<std::size_t>(q)];
+    const double band = std::max(4.0 * noise_sigma, 0.01);
+    std::vector<cv::Point2f> footprint;
+    std::vector<double> heights;
+    for (const Eigen::Vector3f& p : cloud.points) {
+        if (std::abs(p.z() - top) > band) continue;
+        footprint.emplace_back(p.x(), p.y());
+        heights.push_back(p.z());
+    }
+    // The highest readings must be a top: a horizontal surface, not the upper strip of a wall.
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+    for (std::size_t i = 0; i < footprint.size(); ++i) {
+        const Eigen::Vector3d p(footprint[i].x, footprint[i].y, heights[i]);
+        mean += p;
+        outer += p * p.transpose();
+    }
+    bool horizontal = false;
+    if (!footprint.empty()) {
+        mean /= static_cast<double>(footprint.size());
+        const Eigen::Matrix3d cov =
+            outer / static_cast<double>(footprint.size()) - mean * mean.transpose();
+        horizontal =
+            std::abs(
+                Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0).z()) >
+            std::cos(M_PI / 6.0);
+    }
+    if (static_cast<int>(footprint.size()) < 10 * config.min_cell_points || !horizontal) {
+        return Error{ErrorCode::kInsufficientData,
+                     "a single view that shows no top face cannot bound the object"};
+    }
+    // Mixed readings at the top's far edge (between the top and the table behind it) lie
+    // beyond the edge, sparsely: the top's footprint is its densely read cells (a cell twice the
+    // readings' spacing holds about four; one holding less than half the typical count is edge
+    // or stray), whose centres span the top to within half a cell at each edge.
+    std::vector<cv::Point2f> raw_hull;
+    cv::convexHull(footprint, raw_hull);
+    const double raw_spacing = std::sqrt(cv::contourArea(raw_hull) / footprint.size());
+    const double cell = std::max(2.0 * raw_spacing, 0.002);
+    std::vector<Eigen::Vector2d> top_xy;
+    for (const cv::Point2f& p : footprint) top_xy.emplace_back(p.x, p.y);
+    const auto counts = CountFootprintCells(top_xy, cell);
+    std::vector<int> all_counts;
+    for (const auto& [key, n] : counts) all_counts.push_back(n);
+    std::nth_element(all_counts.begin(),
+                     all_counts.begin() + static_cast<long>(all_counts.size() / 2),
+                     all_counts.end());
+    const int typical = all_counts[all_counts.size() / 2];
+    std::vector<cv::Point2f> dense;
+    for (const auto& [key, n] : counts) {
+        if (2 * n < typical) continue;
+        dense.emplace_back(static_cast<float>((key.first + 0.5) * cell),
+                           static_cast<float>((key.second + 0.5) * cell));
+    }
+    if (dense.size() < 3) {
+        return Error{ErrorCode::kInsufficientData, "the top face is too small to bound the object"};
+    }
+    std::vector<cv::Point2f> hull;
+    cv::convexHull(dense, hull);
+    // The outermost dense cells straddle the edge: their centres stand within half a cell of it,
+    // inside where the cell is mostly top, outside where the edge's mixed readings fill it.
+    const cv::RotatedRect rect = cv::minAreaRect(hull);
+    const double a = rect.size.width, b = rect.size.height;
+    const double angle = rect.angle * M_PI / 180.0;
+    EnclosingCuboid c;
+    c.center_m = Eigen::Vector2d(rect.center.x, rect.center.y);
+    const Eigen::Vector2d axis_a(std::cos(angle), std::sin(angle));
+    c.length_axis = a >= b ? axis_a : Eigen::Vector2d(-axis_a.y(), axis_a.x());
+    c.length_m = std::max(a, b);
+    c.width_m = std::min(a, b);
+    std::nth_element(heights.begin(), heights.begin() + static_cast<long>(heights.size() / 2),
+                     heights.end());
+    c.height_m = heights[heights.size() / 2];
+    // An edge is known to within its cell (uniform over it: sigma cell / √12) and the readings'
+    // spacing (how far the last reading may stand from the true edge).
+    const double spacing = raw_spacing;
+    const double edge = std::hypot(cell / std::sqrt(12.0), spacing);
+    c.sigma_m = {std::sqrt(2.0) * edge, std::sqrt(2.0) * edge,
+                 noise_sigma / std::sqrt(static_cast<double>(heights.size())) + 0.5 * spacing};
+    c.cuboid = true;
+    c.assumed = true;
+    c.fill = std::min(1.0, cv::contourArea(hull) / std::max(a * b, 1e-12));
+    return c;
+}
+
+}  // namespace boxd::envelope

@@ -1,0 +1,127 @@
+#include "pipeline/support_envelope.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pipeline/surface_cells.h"
+
+namespace boxd::envelope {
+
+namespace {
+
+// The outer layer's largest bound in direction (cos φ, sin φ) and in the opposite one, over
+// cells of (position across the direction, height).
+struct Support {
+    double forward = -INFINITY, backward = -INFINITY;
+    double se_forward = 0.0, se_backward = 0.0;
+};
+
+Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double sigma,
+                     double radius, double top, const EnvelopeConfig& config) {
+    const Eigen::Vector2d u(std::cos(phi), std::sin(phi)), v(-u.y(), u.x());
+    CellGrid<LayerCell> front(-radius, radius, 0.0, top, config.cell_along_m, config.cell_height_m);
+    CellGrid<LayerCell> back = front;
+    std::vector<double> max_s(front.cells.size(), -INFINITY), min_s(front.cells.size(), INFINITY);
+    auto index = [&front](const LayerCell* c) {
+        return static_cast<std::size_t>(c - front.cells.data());
+    };
+    for (const Eigen::Vector3f& p : pts) {
+        const Eigen::Vector2d q = p.head<2>().cast<double>();
+        if (LayerCell* c = front.At(v.dot(q), p.z())) {
+            const std::size_t k = index(c);
+            const double s = u.dot(q);
+            max_s[k] = std::max(max_s[k], s);
+            min_s[k] = std::min(min_s[k], s);
+        }
+    }
+    const double layer = config.layer_sigmas * sigma;
+    for (const Eigen::Vector3f& p : pts) {
+        const Eigen::Vector2d q = p.head<2>().cast<double>();
+        LayerCell* c = front.At(v.dot(q), p.z());
+        if (c == nullptr) continue;
+        const std::size_t k = index(c);
+        const double s = u.dot(q), t = v.dot(q);
+        if (s >= max_s[k] - layer) c->Add3(t, p.z(), s);
+        if (s <= min_s[k] + layer) back.cells[k].Add3(-t, p.z(), -s);
+    }
+    Support out;
+    int judged = 0;
+    out.forward = LargestBound(front.cells, config, sigma, &out.se_forward, &judged);
+    out.backward = LargestBound(back.cells, config, sigma, &out.se_backward, &judged);
+    return out;
+}
+
+}  // namespace
+
+double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double radius,
+                const EnvelopeConfig& config, double* se) {
+    CellGrid<LayerCell> grid(-radius, radius, -radius, radius, 2.0 * config.cell_along_m,
+                             2.0 * config.cell_along_m);
+    std::vector<double> max_z(grid.cells.size(), -INFINITY);
+    for (const Eigen::Vector3f& p : pts) {
+        if (LayerCell* c = grid.At(p.x(), p.y())) {
+            const auto k = static_cast<std::size_t>(c - grid.cells.data());
+            max_z[k] = std::max(max_z[k], static_cast<double>(p.z()));
+        }
+    }
+    for (const Eigen::Vector3f& p : pts) {
+        if (LayerCell* c = grid.At(p.x(), p.y())) {
+            const auto k = static_cast<std::size_t>(c - grid.cells.data());
+            if (p.z() >= max_z[k] - config.layer_sigmas * sigma) c->Add3(p.x(), p.y(), p.z());
+        }
+    }
+    int judged = 0;
+    return LargestBound(grid.cells, config, sigma, se, &judged);
+}
+
+Result<EnclosingCuboid> EnvelopeCuboid(const FusedCloud& cloud, double sigma,
+                                       const EnvelopeConfig& config) {
+    const Surface surface = SurfaceAbove(cloud, config);
+    const std::vector<Eigen::Vector3f>& pts = surface.points;
+    if (pts.empty()) return Error{ErrorCode::kInsufficientData, "no surface above the table"};
+    const double radius = surface.radius, top = surface.top;
+    auto width = [&](double phi, Support* s) {
+        *s = SupportAlong(pts, phi, sigma, radius, top, config);
+        return s->forward + s->backward;
+    };
+    // Every direction, then finer about the least area.
+    const int n = config.directions;
+    std::vector<Support> coarse(static_cast<std::size_t>(n));
+    std::vector<double> w(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) w[i] = width(M_PI * i / n, &coarse[i]);
+    int best = 0;
+    for (int i = 1; i < n; ++i) {
+        if (w[i] * w[(i + n / 2) % n] < w[best] * w[(best + n / 2) % n]) best = i;
+    }
+    double best_phi = M_PI * best / n, best_area = w[best] * w[(best + n / 2) % n];
+    Support su = coarse[best], sv = coarse[(best + n / 2) % n];
+    for (int j = -9; j <= 9; ++j) {
+        const double phi = M_PI * best / n + j * (M_PI / n) / 10.0;
+        Support a, b;
+        const double area = width(phi, &a) * width(phi + M_PI / 2.0, &b);
+        if (area < best_area) {
+            best_area = area;
+            best_phi = phi;
+            su = a;
+            sv = b;
+        }
+    }
+    if (!std::isfinite(best_area)) {
+        return Error{ErrorCode::kInsufficientData, "too few surface cells to bound the object"};
+    }
+    EnclosingCuboid c;
+    const Eigen::Vector2d u(std::cos(best_phi), std::sin(best_phi)), v(-u.y(), u.x());
+    const double lu = su.forward + su.backward, lv = sv.forward + sv.backward;
+    c.center_m = 0.5 * (su.forward - su.backward) * u + 0.5 * (sv.forward - sv.backward) * v;
+    c.length_m = std::max(lu, lv);
+    c.width_m = std::min(lu, lv);
+    c.length_axis = lu >= lv ? u : v;
+    double se_top = 0.0;
+    c.height_m = TopBound(pts, sigma, radius, config, &se_top);
+    const double s_u = std::hypot(su.se_forward, su.se_backward);
+    const double s_v = std::hypot(sv.se_forward, sv.se_backward);
+    c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u, se_top};
+    return c;
+}
+
+}  // namespace boxd::envelope

@@ -1,0 +1,24 @@
+#pragma once
+// The support function of a surface: how far its outer layer reaches in each direction, read
+// from cells of that layer (surface_cells.h). The footprint is the least-area rectangle of the
+// support over all directions and the height the top's reach: the enclosing cuboid of objects
+// without flat faces (enclosing_cuboid.h).
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "pipeline/enclosing_cuboid.h"
+#include "pipeline/fusion.h"
+#include "pipeline/result.h"
+
+namespace boxd::envelope {
+
+// The height: the top's outer layer over (x, y) cells.
+double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double radius,
+                const EnvelopeConfig& config, double* se);
+
+// The least-area footprint rectangle of the support function, and the height.
+Result<EnclosingCuboid> EnvelopeCuboid(const FusedCloud& cloud, double sigma,
+                                       const EnvelopeConfig& config);
+
+}  // namespace boxd::envelope

@@ -1,0 +1,100 @@
+#pragma once
+// Surface cells: the statistics the enclosing cuboid (enclosing_cuboid.h) is built from. The
+// cloud's readings are binned into small cells of a surface or of a direction's outer layer; a
+// cell's mean has the noise of sigma / sqrt(n), and how far the surface reaches is read from
+// the cells whose means could be the largest, corrected for the largest of that much noise.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "pipeline/enclosing_cuboid.h"
+#include "pipeline/fusion.h"
+
+namespace boxd::envelope {
+
+// Returns x with P(N(0,1) > x) = q (bisection on the complementary error function).
+double UpperNormalQuantile(double q);
+
+struct CellStats {
+    int n = 0;
+    double sum = 0.0, sum_sq = 0.0;
+    void Add(double x) {
+        ++n;
+        sum += x;
+        sum_sq += x * x;
+    }
+    double Mean() const { return sum / n; }
+    // Standard error of the mean (sample variance; at least a tenth of a millimetre of spread,
+    // so that a cell of identical readings is not infinitely certain).
+    double StdError() const {
+        const double var = std::max(0.0, (sum_sq - sum * sum / n) / std::max(1, n - 1));
+        return std::sqrt(std::max(var, 1e-8) / n);
+    }
+};
+
+// A cell of an outer layer: the readings' offsets along the direction judged (as CellStats) and
+// their 3-D scatter in (across, up, along) coordinates, which gives the surface's orientation.
+struct LayerCell : CellStats {
+    Eigen::Vector3d sum3 = Eigen::Vector3d::Zero();
+    Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();
+    void Add3(double a, double b, double s) {
+        Add(s);
+        const Eigen::Vector3d p(a, b, s);
+        sum3 += p;
+        sum_outer += p * p.transpose();
+    }
+    // Returns |cos| of the angle between the surface's normal and the direction judged.
+    double Facing() const;
+};
+
+// Returns Φ⁻¹(0.5^(1/m)): the median of the largest of m standard normal draws.
+double MedianOfLargest(int m);
+
+// How far the surface reaches along the cells' axis: the cells whose means could be the largest
+// (within two standard errors of it) compete, and the largest of their means is corrected by the
+// median of the largest of that many noise draws — noise alone then moves the estimate neither
+// out nor in. A flat face has many such cells (a large correction), a tube's tangent few.
+// `se` is the chosen cell's standard error, `judged` the number of cells with enough points.
+// Returns -inf when no cell is judged.
+double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
+                    double noise_sigma, double* se, int* judged);
+
+// A dense grid of cells over a rectangle of the (a, b) plane.
+template <typename Cell>
+struct CellGrid {
+    double a0, b0, da, db;
+    int na, nb;
+    std::vector<Cell> cells;
+    CellGrid(double a_lo, double a_hi, double b_lo, double b_hi, double cell_a, double cell_b)
+        : a0(a_lo), b0(b_lo), da(cell_a), db(cell_b) {
+        na = std::max(1, static_cast<int>(std::ceil((a_hi - a_lo) / cell_a)));
+        nb = std::max(1, static_cast<int>(std::ceil((b_hi - b_lo) / cell_b)));
+        cells.resize(static_cast<std::size_t>(na) * static_cast<std::size_t>(nb));
+    }
+    Cell* At(double a, double b) {
+        const int i = static_cast<int>(std::floor((a - a0) / da));
+        const int j = static_cast<int>(std::floor((b - b0) / db));
+        if (i < 0 || j < 0 || i >= na || j >= nb) return nullptr;
+        return &cells[static_cast<std::size_t>(j) * static_cast<std::size_t>(na) +
+                      static_cast<std::size_t>(i)];
+    }
+};
+
+// An even subsample of the cloud above the table (at most config.max_points), and how far it
+// reaches from the axis and up, with a centimetre to spare.
+struct Surface {
+    std::vector<Eigen::Vector3f> points;
+    double radius = 0.0, top = 0.0;
+};
+
+Surface SurfaceAbove(const FusedCloud& cloud, const EnvelopeConfig& config);
+
+// Returns how many of `points` (x, y) fall in each square cell of `cell` metres, by cell index.
+std::map<std::pair<int, int>, int> CountFootprintCells(const std::vector<Eigen::Vector2d>& points,
+                                                       double cell);
+
+}  // namespace boxd::envelope
