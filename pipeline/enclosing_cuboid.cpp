@@ -18,8 +18,6 @@ namespace boxd {
 
 namespace {
 
-using envelope::SurfaceAbove;
-
 // Returns the area of the convex hull of the centres of the cells (of `cell` metres) that hold
 // at least `min_points` of `points`.
 double CellHullArea(const std::vector<Eigen::Vector2d>& points, double cell, int min_points) {
@@ -42,10 +40,11 @@ double CellHullArea(const std::vector<Eigen::Vector2d>& points, double cell, int
 // taken of the footprint cells that hold several readings (scattered readings rarely share a
 // cell), and compared with the same hull of the rectangle itself, filled and cut into the same
 // cells, so that the cells' own coarseness cancels.
-double FillRatio(const FusedCloud& cloud, const EnclosingCuboid& c, const EnvelopeConfig& config) {
+double FillRatio(const envelope::Surface& surface, const EnclosingCuboid& c,
+                 const EnvelopeConfig& config) {
     const double cell = config.fill_cell_m;
     std::vector<Eigen::Vector2d> footprint;
-    for (const Eigen::Vector3f& p : SurfaceAbove(cloud, config).points) {
+    for (const Eigen::Vector3f& p : surface.points) {
         footprint.push_back(p.head<2>().cast<double>());
     }
     const Eigen::Vector2d a = c.length_axis, b(-a.y(), a.x());
@@ -88,8 +87,12 @@ Status EnvelopeConfig::Validate() const {
 Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result<BoxFit>& box,
                                            int views, double agreement_m, double noise_sigma_m,
                                            const EnvelopeConfig& config) {
-    if (views == 1)
+    if (views == 1) {
         return envelope::SingleViewCuboid(cloud, std::max(noise_sigma_m, 0.0005), config);
+    }
+    // The subsample of the surface above the table that the fill, the support function and a
+    // grazing top's height all read.
+    const envelope::Surface surface = envelope::SurfaceAbove(cloud, config);
     if (box) {
         const BoxFit& fit = *box;
         const std::array<envelope::FaceResult, 5> faces =
@@ -108,7 +111,6 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
         double top_se = 0.0;
         if (!fit.top_observed) {
             // No top face to fit: the height is where the side faces end.
-            const envelope::Surface surface = SurfaceAbove(cloud, config);
             c.height_m = envelope::TopBound(surface.points, std::max(noise_sigma_m, 0.0005),
                                             surface.radius, config, &top_se);
         }
@@ -128,7 +130,7 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
         const double s_v = std::hypot(face_sigma(2), face_sigma(3));
         c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u,
                      fit.top_observed ? face_sigma(4) : top_se};
-        c.fill = FillRatio(cloud, c, config);
+        c.fill = FillRatio(surface, c, config);
         // A flat face stands where every view sees it, up to the views' registration; a curved
         // "face" (a tube's side) stands where each view's tangent is.
         double spread = 0.0;
@@ -152,10 +154,10 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     // The outer layer of a cell column is the sensor's noise deep: the noise of the table top
     // about its plane, seen at about the object's distance.
     const double sigma = std::max(noise_sigma_m, 0.0005);
-    auto c = envelope::EnvelopeCuboid(cloud, sigma, config);
+    auto c = envelope::EnvelopeCuboid(surface, sigma, config);
     if (!c) return c;
     c->cuboid = false;
-    c->fill = FillRatio(cloud, *c, config);
+    c->fill = FillRatio(surface, *c, config);
     return c;
 }
 

@@ -16,6 +16,40 @@ MeasurementReason Moved(const std::string& why) {
     return MeasurementReason{ErrorCode::kObjectMoved, why + ": the object moved on the table"};
 }
 
+// NO_OBJECT when too few points survive fusion.
+std::optional<MeasurementReason> ThinCloud(const FusedFit& fit, const RefusalConfig& refuse) {
+    if (static_cast<long>(fit.fused.points.size()) >= refuse.min_object_points) return std::nullopt;
+    return MeasurementReason{ErrorCode::kNoObject, "nothing stands on the table"};
+}
+
+// OBJECT_TOO_SMALL when the smaller of the footprint's width and the height is under the limit.
+std::optional<MeasurementReason> TooSmall(double width_m, double height_m,
+                                          const RefusalConfig& refuse) {
+    if (std::min(width_m, height_m) >= refuse.min_dimension_m) return std::nullopt;
+    return MeasurementReason{
+        ErrorCode::kObjectTooSmall,
+        fmt::format("the object is smaller than {:.0f} mm", refuse.min_dimension_m * 1000.0)};
+}
+
+// OBJECT_MOVED when a view disagrees with the fitted box, REGISTRATION_FAILED when its faces are
+// not flat (`fit.box` holds a box).
+std::optional<MeasurementReason> BoxFacesDisagree(const FusedFit& fit,
+                                                  const RefusalConfig& refuse) {
+    const ConsistencyReport& c = fit.consistency;
+    if (!c.inconsistent_views.empty()) {
+        return Moved(
+            fmt::format("view {} disagrees with the others ({:.0f}% of its points on the box)",
+                        c.worst_view, 100.0 * c.worst_inlier_fraction));
+    }
+    if (fit.box->face_sigma_m > refuse.max_face_sigma_m) {
+        return MeasurementReason{
+            ErrorCode::kRegistrationFailed,
+            fmt::format("the box faces are not flat to {:.0f} mm (sigma {:.1f} mm)",
+                        refuse.max_face_sigma_m * 1000.0, fit.box->face_sigma_m * 1000.0)};
+    }
+    return std::nullopt;
+}
+
 }  // namespace
 
 Status RefusalConfig::Validate() const {
@@ -105,29 +139,10 @@ std::optional<MeasurementReason> CheckRegisteredViews(const RegisteredViews& reg
 }
 
 std::optional<MeasurementReason> CheckFusedFit(const FusedFit& fit, const RefusalConfig& refuse) {
-    if (static_cast<long>(fit.fused.points.size()) < refuse.min_object_points) {
-        return MeasurementReason{ErrorCode::kNoObject, "nothing stands on the table"};
-    }
+    if (auto why = ThinCloud(fit, refuse)) return why;
     if (!fit.box) return fit.box.error();
-    const BoxFit& box = *fit.box;
-    if (std::min(box.width_m, box.height_m) < refuse.min_dimension_m) {
-        return MeasurementReason{
-            ErrorCode::kObjectTooSmall,
-            fmt::format("the object is smaller than {:.0f} mm", refuse.min_dimension_m * 1000.0)};
-    }
-    const ConsistencyReport& c = fit.consistency;
-    if (!c.inconsistent_views.empty()) {
-        return Moved(
-            fmt::format("view {} disagrees with the others ({:.0f}% of its points on the box)",
-                        c.worst_view, 100.0 * c.worst_inlier_fraction));
-    }
-    if (box.face_sigma_m > refuse.max_face_sigma_m) {
-        return MeasurementReason{
-            ErrorCode::kRegistrationFailed,
-            fmt::format("the box faces are not flat to {:.0f} mm (sigma {:.1f} mm)",
-                        refuse.max_face_sigma_m * 1000.0, box.face_sigma_m * 1000.0)};
-    }
-    return std::nullopt;
+    if (auto why = TooSmall(fit.box->width_m, fit.box->height_m, refuse)) return why;
+    return BoxFacesDisagree(fit, refuse);
 }
 
 std::optional<MeasurementReason> CheckSingleObject(const FusedCloud& fused,
@@ -174,32 +189,13 @@ std::optional<MeasurementReason> CheckEnclosingCuboid(const FusedFit& fit,
                                                       const Result<EnclosingCuboid>& cuboid,
                                                       const std::array<double, 3>& uncertainty_m,
                                                       const RefusalConfig& refuse) {
-    if (static_cast<long>(fit.fused.points.size()) < refuse.min_object_points) {
-        return MeasurementReason{ErrorCode::kNoObject, "nothing stands on the table"};
-    }
+    if (auto why = ThinCloud(fit, refuse)) return why;
     if (!cuboid) return cuboid.error();
-    const EnclosingCuboid& c = *cuboid;
-    if (std::min(c.width_m, c.height_m) < refuse.min_dimension_m) {
-        return MeasurementReason{
-            ErrorCode::kObjectTooSmall,
-            fmt::format("the object is smaller than {:.0f} mm", refuse.min_dimension_m * 1000.0)};
-    }
+    if (auto why = TooSmall(cuboid->width_m, cuboid->height_m, refuse)) return why;
     // A cuboid's faces and views are judged against its box; other shapes have no faces, and
     // their views are judged by the registration alone.
-    if (c.cuboid && fit.box) {
-        const ConsistencyReport& r = fit.consistency;
-        if (!r.inconsistent_views.empty()) {
-            return Moved(
-                fmt::format("view {} disagrees with the others ({:.0f}% of its points on "
-                            "the box)",
-                            r.worst_view, 100.0 * r.worst_inlier_fraction));
-        }
-        if (fit.box->face_sigma_m > refuse.max_face_sigma_m) {
-            return MeasurementReason{
-                ErrorCode::kRegistrationFailed,
-                fmt::format("the box faces are not flat to {:.0f} mm (sigma {:.1f} mm)",
-                            refuse.max_face_sigma_m * 1000.0, fit.box->face_sigma_m * 1000.0)};
-        }
+    if (cuboid->cuboid && fit.box) {
+        if (auto why = BoxFacesDisagree(fit, refuse)) return why;
     }
     const double worst = *std::max_element(uncertainty_m.begin(), uncertainty_m.end());
     if (worst > refuse.max_uncertainty_m) {

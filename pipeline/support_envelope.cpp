@@ -74,9 +74,8 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double ra
     return LargestBound(grid.cells, config, sigma, se, &judged);
 }
 
-Result<EnclosingCuboid> EnvelopeCuboid(const FusedCloud& cloud, double sigma,
+Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma,
                                        const EnvelopeConfig& config) {
-    const Surface surface = SurfaceAbove(cloud, config);
     const std::vector<Eigen::Vector3f>& pts = surface.points;
     if (pts.empty()) return Error{ErrorCode::kInsufficientData, "no surface above the table"};
     const double radius = surface.radius, top = surface.top;

@@ -10,6 +10,7 @@
 #include "pipeline/enclosing_cuboid.h"
 #include "pipeline/fusion.h"
 #include "pipeline/result.h"
+#include "pipeline/surface_cells.h"
 
 namespace boxd::envelope {
 
@@ -18,7 +19,7 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double ra
                 const EnvelopeConfig& config, double* se);
 
 // The least-area footprint rectangle of the support function, and the height.
-Result<EnclosingCuboid> EnvelopeCuboid(const FusedCloud& cloud, double sigma,
+Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma,
                                        const EnvelopeConfig& config);
 
 }  // namespace boxd::envelope
