@@ -11,6 +11,7 @@
 #include "pipeline/object_views.h"
 #include "pipeline/refusal.h"
 #include "pipeline/register_views.h"
+#include "pipeline/registration_uncertainty.h"
 #include "pipeline/table_plane.h"
 
 namespace boxd {
@@ -136,7 +137,16 @@ Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<Prepar
         quality.footprint_fill = cuboid->fill;
         quality.face_excess_ratio = cuboid->max_relative_excess;
         quality.cuboid_assumed = cuboid->assumed;
-        for (std::size_t i = 0; i < 3; ++i) uncertainty[i] = kCoverage95 * cuboid->sigma_m[i];
+        // The faces' own scatter, and what the registration may still have moved them by.
+        const auto moved = RegistrationSigma(fit.fused, *cuboid, registered->poses,
+                                             registered->pose_covariance);
+        spdlog::debug("uncertainty: faces {:.3f} {:.3f} {:.3f} mm, registration {:.3f} {:.3f} mm",
+                      cuboid->sigma_m[0] * 1e3, cuboid->sigma_m[1] * 1e3,
+                      cuboid->sigma_m[2] * 1e3, moved[0] * 1e3, moved[1] * 1e3);
+        for (std::size_t i = 0; i < 3; ++i) {
+            const double registration = i < 2 ? moved[i] : 0.0;
+            uncertainty[i] = kCoverage95 * std::hypot(cuboid->sigma_m[i], registration);
+        }
     }
     const auto why = CheckEnclosingCuboid(fit, cuboid, uncertainty, refuse);
     m.out.cloud = std::move(fit.fused.points);

@@ -6,10 +6,16 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <optional>
 
 namespace boxd {
 
 namespace {
+
+// Variance components: estimation rounds, and the smallest factor a group may get (a group whose
+// residuals vanish, as in a noise-free simulation, must not become infinitely certain).
+constexpr int kVarianceRounds = 5;
+constexpr double kMinVarianceFactor = 1e-4;
 
 template <typename T>
 T NormalizeAngle(const T& a) {
@@ -142,6 +148,79 @@ void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Problem
     }
 }
 
+// The whitened residuals and their Jacobian at the graph's solution, with respect to nodes
+// 1..n-1 and the centre offset (node 0 is the gauge). The residual blocks come in BuildProblem's
+// order: the kept edges' rows, then the priors'.
+struct Linearization {
+    Eigen::MatrixXd jacobian;
+    Eigen::VectorXd residuals;
+    int edge_rows = 0;
+};
+
+std::optional<Linearization> Linearize(const PoseGraph& graph, const PoseGraphConfig& config) {
+    const int n = static_cast<int>(graph.poses.size());
+    Problem p;
+    BuildProblem(graph, config, p);
+    ceres::Problem::EvaluateOptions options;
+    for (int k = 1; k < n; ++k) options.parameter_blocks.push_back(p.params[k].data());
+    options.parameter_blocks.push_back(p.center.data());
+    double cost = 0.0;
+    std::vector<double> residuals;
+    ceres::CRSMatrix crs;
+    if (!p.problem->Evaluate(options, &cost, &residuals, nullptr, &crs)) return std::nullopt;
+    Linearization out;
+    out.jacobian = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+    for (int r = 0; r < crs.num_rows; ++r) {
+        for (int i = crs.rows[r]; i < crs.rows[r + 1]; ++i) {
+            out.jacobian(r, crs.cols[i]) = crs.values[i];
+        }
+    }
+    out.residuals = Eigen::Map<const Eigen::VectorXd>(residuals.data(), crs.num_rows);
+    out.edge_rows = crs.num_rows - 3 * (n - 1);
+    return out;
+}
+
+// Returns (JᵀJ)⁻¹, or nothing when the graph leaves a direction free.
+std::optional<Eigen::MatrixXd> NormalInverse(const Eigen::MatrixXd& jacobian) {
+    const Eigen::Index m = jacobian.cols();
+    Eigen::LDLT<Eigen::MatrixXd> ldlt(jacobian.transpose() * jacobian);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 0.0).all()) {
+        return std::nullopt;
+    }
+    return Eigen::MatrixXd(ldlt.solve(Eigen::MatrixXd::Identity(m, m)));
+}
+
+// The covariance of nodes 1..n-1 by variance-component estimation: each group's (edges',
+// prior's) rows are scaled by its factor, its squared whitened residuals over its redundancy
+// Σ (1 − h_ii) with H = J (JᵀJ)⁻¹ Jᵀ — the share of the residuals' degrees of freedom that the
+// group holds — and the split repeated until it settles. A group with less than one degree of
+// freedom keeps its configured weight.
+std::optional<Eigen::MatrixXd> VarianceComponentCovariance(const Linearization& lin) {
+    const Eigen::Index rows = lin.jacobian.rows();
+    const int groups[2][2] = {{0, lin.edge_rows},
+                              {lin.edge_rows, static_cast<int>(rows) - lin.edge_rows}};
+    Eigen::VectorXd scale = Eigen::VectorXd::Ones(rows);
+    std::optional<Eigen::MatrixXd> inverse;
+    for (int round = 0; round < kVarianceRounds; ++round) {
+        const Eigen::MatrixXd wj = scale.cwiseInverse().cwiseSqrt().asDiagonal() * lin.jacobian;
+        inverse = NormalInverse(wj);
+        if (!inverse) return std::nullopt;
+        if (round + 1 == kVarianceRounds) break;
+        const Eigen::VectorXd leverage = (wj * *inverse).cwiseProduct(wj).rowwise().sum();
+        for (const auto& [first, count] : groups) {
+            const double redundancy = count - leverage.segment(first, count).sum();
+            if (count == 0 || redundancy < 1.0) continue;
+            const double factor = lin.residuals.segment(first, count)
+                                      .cwiseAbs2()
+                                      .cwiseQuotient(scale.segment(first, count))
+                                      .sum() /
+                                  redundancy;
+            scale.segment(first, count) *= std::max(factor, kMinVarianceFactor);
+        }
+    }
+    return inverse;
+}
+
 }  // namespace
 
 Status PoseGraphConfig::Validate() const {
@@ -156,6 +235,24 @@ Status PoseGraphConfig::Validate() const {
     if (max_rejection_rounds < 0) return bad("max_rejection_rounds", "must be >= 0");
     if (max_solver_iterations < 1) return bad("max_solver_iterations", "must be >= 1");
     return OkStatus();
+}
+
+Eigen::MatrixXd PoseCovariance(const PoseGraph& graph, const PoseGraphConfig& config) {
+    const int n = static_cast<int>(graph.poses.size());
+    Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(3 * n, 3 * n);
+    if (n < 2) return cov;
+    const Eigen::Index nodes = 3 * (n - 1);
+    const auto lin = Linearize(graph, config);
+    const auto inverse = lin ? VarianceComponentCovariance(*lin) : std::nullopt;
+    if (inverse && lin->edge_rows > 0) {
+        cov.bottomRightCorner(nodes, nodes) = inverse->topLeftCorner(nodes, nodes);
+        return cov;
+    }
+    // The turntable model alone: each pose as well as the prior says.
+    const double c2 = config.prior_center_sigma_m * config.prior_center_sigma_m;
+    const double y2 = config.prior_yaw_sigma_rad * config.prior_yaw_sigma_rad;
+    for (int k = 1; k < n; ++k) cov.diagonal().segment<3>(3 * k) = Eigen::Vector3d(c2, c2, y2);
+    return cov;
 }
 
 Eigen::Vector3d EdgeResidual(const PoseGraph& graph, const PoseEdge& edge) {

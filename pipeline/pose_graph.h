@@ -65,6 +65,14 @@ Status SolvePoseGraph(PoseGraph& graph, const PoseGraphConfig& config);
 // Solves, rejects the worst disagreeing edge, and re-solves until every kept edge agrees.
 Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfig& config);
 
+// Returns the covariance of the solved poses, 3N x 3N in (x, y, yaw) per node (node 0 defines
+// the frame: its rows are zero). The inverse of JᵀJ of the whitened residuals at the solution,
+// with the ICP edges and the turntable prior each weighted by its variance component estimated
+// from its own residuals (Förstner): the configured sigmas only weigh the solve, the scatter
+// the solution shows decides how well the poses are known. Without redundancy (no edges: the
+// turntable model alone) the prior's configured sigmas, per node.
+Eigen::MatrixXd PoseCovariance(const PoseGraph& graph, const PoseGraphConfig& config);
+
 // Returns the residual (x, y, yaw) of `edge` at the graph's current poses.
 Eigen::Vector3d EdgeResidual(const PoseGraph& graph, const PoseEdge& edge);
 

@@ -23,6 +23,7 @@ Result<RegisteredViews> RegisterViews(const std::vector<RegistrationClouds>& clo
         spdlog::info("registration: the pose graph rejected {} of {} alignments that disagreed",
                      report->rejected_edges, report->rejected_edges + report->active_edges);
     }
+    out.pose_covariance = PoseCovariance(graph, pose_graph);
     out.poses = std::move(graph.poses);
     out.graph = *report;
     return out;

@@ -16,6 +16,7 @@ struct RegisteredViews {
     std::vector<Se2> poses;  // per view: maps its points into the frame of pose 0
     PoseGraphReport graph;   // kept / rejected edges, deviation from the turntable model
     EdgeStats edges;         // ICP alignments attempted and accepted, their mean RMSE
+    Eigen::MatrixXd pose_covariance;  // of `poses`, 3N x 3N (PoseCovariance)
 };
 
 // Returns the registered poses of the views whose clouds are `clouds`, seen at turntable

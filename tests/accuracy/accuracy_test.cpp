@@ -111,6 +111,12 @@ Outcome RunCase(const json& c) {
     return o;
 }
 
+double Median(std::vector<double> v) {
+    if (v.empty()) return NAN;
+    std::nth_element(v.begin(), v.begin() + static_cast<long>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+}
+
 TEST(Accuracy, SyntheticSuiteWithinTolerance) {
     std::ifstream in(std::string(BOXD_SOURCE_DIR) + "/tests/accuracy/cases.json");
     ASSERT_TRUE(in) << "tests/accuracy/cases.json not found";
@@ -130,6 +136,7 @@ TEST(Accuracy, SyntheticSuiteWithinTolerance) {
 
     std::map<std::string, std::array<double, 3>> worst;
     int covered = 0, judged = 0;
+    std::vector<double> box_errors, box_bounds;
     std::printf("\n%-24s %-10s %-9s %-9s %8s %8s %8s %6s %24s %8s\n", "case", "group", "status",
                 "shape", "dL mm", "dW mm", "dH mm", "tol mm", "95% bound L/W/H mm", "proc ms");
     for (const Outcome& o : outcomes) {
@@ -145,14 +152,23 @@ TEST(Accuracy, SyntheticSuiteWithinTolerance) {
                 std::max(w[static_cast<std::size_t>(k)], std::abs(o.err[k]));
             ++judged;
             covered += std::abs(o.err[k]) <= o.uncertainty[k] ? 1 : 0;
+            if (o.group == "box") {
+                box_errors.push_back(std::abs(o.err[k]));
+                box_bounds.push_back(o.uncertainty[k]);
+            }
         }
     }
     for (const auto& [group, w] : worst) {
         std::printf("worst |error| %-10s %8.2f %8.2f %8.2f mm\n", group.c_str(), w[0] * 1000,
                     w[1] * 1000, w[2] * 1000);
     }
-    std::printf("true error within the reported 95%% bound: %d of %d dimensions\n\n", covered,
+    std::printf("true error within the reported 95%% bound: %d of %d dimensions\n", covered,
                 judged);
+    std::printf("ideal boxes: median bound %.2f mm, median |error| %.2f mm\n\n",
+                Median(box_bounds) * 1000, Median(box_errors) * 1000);
+    // SPEC section 5's bound is meant to hold for 95% of dimensions; until it does (see the
+    // README's accuracy section) this guards what it reaches against going back.
+    EXPECT_GE(covered, judged * 85 / 100) << "uncertainty coverage fell";
     for (const Outcome& o : outcomes) {
         if (!o.expect.empty()) {
             EXPECT_EQ(o.status, "no_dim") << o.name;

@@ -17,9 +17,9 @@ struct Ring {
     PoseGraph graph;
 };
 
-Ring MakeRing(int n, Eigen::Vector2d center, unsigned seed) {
+Ring MakeRing(int n, Eigen::Vector2d center, unsigned seed, double edge_sigma_m = 0.0002) {
     std::mt19937 rng(seed);
-    std::normal_distribution<double> angle_err(0.0, 0.3 * kDeg), t_noise(0.0, 0.0002),
+    std::normal_distribution<double> angle_err(0.0, 0.3 * kDeg), t_noise(0.0, edge_sigma_m),
         yaw_noise(0.0, 0.02 * kDeg);
     Ring ring;
     for (int k = 0; k < n; ++k) {
@@ -99,6 +99,69 @@ TEST(OptimizePoseGraph, MovedObjectIsReportedAsDisagreement) {
     EXPECT_TRUE(report->rejected_edges >= 3 ||
                 std::max(report->max_model_yaw_deviation_rad / (3.0 * kDeg),
                          report->max_model_translation_deviation_m / 0.015) > 1.0);
+}
+
+// The largest 1-sigma translation of any node, from the covariance's diagonal.
+double LargestTranslationSigma(const Eigen::MatrixXd& cov) {
+    double worst = 0.0;
+    for (Eigen::Index k = 0; k < cov.rows() / 3; ++k) {
+        worst = std::max(worst, std::sqrt(cov(3 * k, 3 * k) + cov(3 * k + 1, 3 * k + 1)));
+    }
+    return worst;
+}
+
+TEST(PoseCovariance, FollowsTheEdgesScatterNotTheirConfiguredSigma) {
+    PoseGraphConfig config;
+    double sigma[2];
+    for (int i = 0; i < 2; ++i) {
+        // The same ring with edges four times as noisy; the configured sigma stays the same.
+        Ring ring = MakeRing(18, {0.002, 0.001}, 4, i == 0 ? 0.0002 : 0.0008);
+        ASSERT_TRUE(OptimizePoseGraph(ring.graph, config).ok());
+        const Eigen::MatrixXd cov = PoseCovariance(ring.graph, config);
+        ASSERT_EQ(cov.rows(), 54);
+        EXPECT_TRUE((cov.block<3, 3>(0, 0).isZero())) << "node 0 defines the frame";
+        EXPECT_TRUE(cov.isApprox(cov.transpose()));
+        sigma[i] = LargestTranslationSigma(cov);
+        EXPECT_GT(sigma[i], 0.0);
+    }
+    // Four times the noise: about four times the sigma (the prior weighs in a little).
+    EXPECT_GT(sigma[1] / sigma[0], 2.5);
+    EXPECT_LT(sigma[1] / sigma[0], 5.0);
+}
+
+TEST(PoseCovariance, IsWithinAFactorOfTheTrueScatter) {
+    // Many rings with the same noise: the covariance's sigma against the poses' actual errors.
+    PoseGraphConfig config;
+    double predicted = 0.0, squared_error = 0.0;
+    int count = 0;
+    for (unsigned seed = 10; seed < 40; ++seed) {
+        Ring ring = MakeRing(12, {0.0, 0.0}, seed, 0.0005);
+        ASSERT_TRUE(OptimizePoseGraph(ring.graph, config).ok());
+        const Eigen::MatrixXd cov = PoseCovariance(ring.graph, config);
+        for (std::size_t k = 1; k < ring.truth.size(); ++k) {
+            // Relative to node 0, as the covariance is.
+            const Se2 rel = ring.graph.poses[0].Inverse().Compose(ring.graph.poses[k]);
+            const Se2 truth = ring.truth[0].Inverse().Compose(ring.truth[k]);
+            squared_error += Se2Difference(rel, truth).head<2>().squaredNorm();
+            predicted += cov(3 * k, 3 * k) + cov(3 * k + 1, 3 * k + 1);
+            ++count;
+        }
+    }
+    const double ratio = std::sqrt(predicted / squared_error);
+    EXPECT_GT(ratio, 0.5);
+    EXPECT_LT(ratio, 2.0);
+}
+
+TEST(PoseCovariance, TurntableModelAloneTakesThePriorsSigmas) {
+    Ring ring = MakeRing(4, {0.0, 0.0}, 5);
+    ring.graph.edges.clear();
+    PoseGraphConfig config;
+    ASSERT_TRUE(OptimizePoseGraph(ring.graph, config).ok());
+    const Eigen::MatrixXd cov = PoseCovariance(ring.graph, config);
+    for (Eigen::Index k = 1; k < 4; ++k) {
+        EXPECT_NEAR(std::sqrt(cov(3 * k, 3 * k)), config.prior_center_sigma_m, 1e-12);
+        EXPECT_NEAR(std::sqrt(cov(3 * k + 2, 3 * k + 2)), config.prior_yaw_sigma_rad, 1e-12);
+    }
 }
 
 TEST(PoseGraphConfig, ValidateNamesField) {
