@@ -60,6 +60,27 @@ double FillRatio(const envelope::Surface& surface, const EnclosingCuboid& c,
     return std::min(1.0, CellHullArea(footprint, cell, config.fill_cell_points) / reference);
 }
 
+// The share of the footprint cells (fill_cell_m, holding at least fill_cell_points readings) whose
+// highest reading lies within the top band below `height`.
+double TopCover(const envelope::Surface& surface, double height, const EnvelopeConfig& config) {
+    const double cell = config.fill_cell_m;
+    std::map<std::pair<int, int>, std::pair<int, float>> cells;  // readings, highest z
+    for (const Eigen::Vector3f& p : surface.points) {
+        auto& c = cells[{static_cast<int>(std::floor(p.x() / cell)),
+                         static_cast<int>(std::floor(p.y() / cell))}];
+        ++c.first;
+        c.second = std::max(c.second, p.z());
+    }
+    const double floor = height - std::max(config.top_band * height, 0.01);
+    int occupied = 0, top = 0;
+    for (const auto& [key, c] : cells) {
+        if (c.first < config.fill_cell_points) continue;
+        ++occupied;
+        top += c.second >= floor ? 1 : 0;
+    }
+    return occupied > 0 ? static_cast<double>(top) / occupied : 0.0;
+}
+
 }  // namespace
 
 Status EnvelopeConfig::Validate() const {
@@ -80,6 +101,8 @@ Status EnvelopeConfig::Validate() const {
     if (!(fill_cell_m > 0.0 && fill_cell_m < 0.05)) return bad("fill_cell_m", "in (0, 0.05)");
     if (fill_cell_points < 1) return bad("fill_cell_points", "must be >= 1");
     if (!(max_relative_excess > 0.0)) return bad("max_relative_excess", "must be > 0");
+    if (!(top_band > 0.0 && top_band < 1.0)) return bad("top_band", "in (0, 1)");
+    if (!(min_top_cover > 0.0 && min_top_cover <= 1.0)) return bad("min_top_cover", "in (0, 1]");
     if (!(max_view_spread_rmse > 0.0)) return bad("max_view_spread_rmse", "must be > 0");
     return OkStatus();
 }
@@ -131,23 +154,24 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
         c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u,
                      fit.top_observed ? face_sigma(4) : top_se};
         c.fill = FillRatio(surface, c, config);
+        c.top_cover = TopCover(surface, c.height_m, config);
         // A flat face stands where every view sees it, up to the views' registration; a curved
         // "face" (a tube's side) stands where each view's tangent is.
         double spread = 0.0;
         for (const envelope::FaceResult& f : faces) spread = std::max(spread, f.view_spread_m);
-        c.cuboid = c.fill >= config.min_fill &&
+        c.cuboid = c.fill >= config.min_fill && c.top_cover >= config.min_top_cover &&
                    c.max_relative_excess <= config.max_relative_excess &&
                    spread <= config.max_view_spread_rmse * std::max(agreement_m, noise_sigma_m / 4);
         spdlog::debug(
             "envelope: face excess {:.2f} {:.2f} {:.2f} {:.2f} top {:.2f} mm (cell se {:.2f} "
             "{:.2f} "
-            "{:.2f} {:.2f} {:.2f}), plane se {:.2f} {:.2f} {:.2f} {:.2f} {:.2f} mm, fill {:.3f}",
+            "{:.2f} {:.2f} {:.2f}), plane se {:.2f} {:.2f} {:.2f} {:.2f} {:.2f} mm, fill {:.3f}, top cover {:.3f}",
             faces[0].excess_m * 1e3, faces[1].excess_m * 1e3, faces[2].excess_m * 1e3,
             faces[3].excess_m * 1e3, faces[4].excess_m * 1e3, faces[0].excess_se_m * 1e3,
             faces[1].excess_se_m * 1e3, faces[2].excess_se_m * 1e3, faces[3].excess_se_m * 1e3,
             faces[4].excess_se_m * 1e3, faces[0].offset_se_m * 1e3, faces[1].offset_se_m * 1e3,
             faces[2].offset_se_m * 1e3, faces[3].offset_se_m * 1e3, faces[4].offset_se_m * 1e3,
-            c.fill);
+            c.fill, c.top_cover);
         if (c.cuboid) return c;
     }
     // No flat faces at right angles: the support function of the surface.
@@ -158,6 +182,7 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     if (!c) return c;
     c->cuboid = false;
     c->fill = FillRatio(surface, *c, config);
+    c->top_cover = TopCover(surface, c->height_m, config);
     return c;
 }
 

@@ -50,6 +50,12 @@ struct EnvelopeConfig {
     double fill_cell_m = 0.01;  // footprint cells of the fill's hull ...
     int fill_cell_points = 3;   // ... holding at least this many readings
     double max_relative_excess = 0.03;
+    // ... and its top is flat over the whole footprint: of the footprint cells that hold readings,
+    // at least min_top_cover reach within top_band of the height up (a box's rounded edge drops
+    // by its radius; an open flap, a lying tube's curve or a bag's top leave most cells far
+    // below their highest point). The band is a share of the height, at least a centimetre.
+    double top_band = 0.1;
+    double min_top_cover = 0.9;
     // ... and each face stands where all views see it: their offsets spread by no more than
     // this many times the registration's RMSE (a tube's side is where each view's tangent is).
     double max_view_spread_rmse = 3.0;
@@ -67,6 +73,7 @@ struct EnclosingCuboid {
     bool cuboid = true;    // flat faces at right angles filling the rectangle
     bool assumed = false;  // one view: the faces it does not show are assumed (a cuboid)
     double fill = 1.0;     // footprint area over rectangle area
+    double top_cover = 1.0;  // share of the footprint's cells whose highest reading is the top's
     double max_relative_excess = 0.0;  // largest face excess over the box size across it
     std::array<double, 5> excess_m{};  // +u, -u, +v, -v sides and the top, beyond the faces
     std::array<double, 3> sigma_m{};   // 1-sigma of length, width, height from the data

@@ -135,6 +135,7 @@ Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<Prepar
     std::array<double, 3> uncertainty{};
     if (cuboid) {
         quality.footprint_fill = cuboid->fill;
+        quality.top_cover = cuboid->top_cover;
         quality.face_excess_ratio = cuboid->max_relative_excess;
         quality.cuboid_assumed = cuboid->assumed;
         // The faces' own scatter, and what the registration may still have moved them by.

@@ -83,6 +83,7 @@ json ToJson(const MeasurementResult& m) {
     if (m.quality.footprint_fill) {
         j["quality"]["footprint_fill"] = Round(*m.quality.footprint_fill, 1e-3);
     }
+    if (m.quality.top_cover) j["quality"]["top_cover"] = Round(*m.quality.top_cover, 1e-3);
     if (m.quality.cuboid_assumed) j["quality"]["cuboid_assumed"] = true;
     if (m.quality.face_excess_ratio) {
         j["quality"]["face_excess_ratio"] = Round(*m.quality.face_excess_ratio, 1e-4);

@@ -40,8 +40,10 @@ struct MeasurementQuality {
     double registration_rmse_m = 0.0;
     double confidence = 0.0;
     // The figures that decide `shape` (enclosing_cuboid.h): the footprint's fill of its
-    // rectangle, and the largest outward excess of a face over its plane, relative to the box.
+    // rectangle, the share of it the top covers, and the largest outward excess of a face over
+    // its plane, relative to the box.
     std::optional<double> footprint_fill;
+    std::optional<double> top_cover;
     std::optional<double> face_excess_ratio;
     // A single view: the faces it does not show were assumed to make a cuboid.
     bool cuboid_assumed = false;

@@ -1,5 +1,6 @@
 // Known-answer tests of the smallest enclosing cuboid on hand-made fused clouds: an ideal box,
-// a box whose long sides bulge, a standing tube, an L-shaped pack and a cloud too thin to bound.
+// a box whose long sides bulge, a standing tube, an L-shaped pack, a carton with a panel standing
+// up and a cloud too thin to bound.
 //
 // The clouds mimic a turntable session: kViews cameras round the object, each sampling every
 // surface that faces it (within 75 degrees of its normal; the top faces all of them) on its own
@@ -217,6 +218,7 @@ TEST(FitEnclosingCuboid, IdealBoxIsTheBoxFitWithNoExcess) {
     // The hull of noisy points is wider than the box, and the ratio is capped at 1.
     EXPECT_GT(c.fill, 0.98);
     EXPECT_LE(c.fill, 1.0);
+    EXPECT_GT(c.top_cover, 0.95);
     // The data's own 1-sigma per dimension: of the order of the views' shifts, not centimetres.
     for (double s : c.sigma_m) {
         EXPECT_GT(s, 0.0);
@@ -304,6 +306,23 @@ TEST(FitEnclosingCuboid, LShapeIsIrregularAndBoundedByItsBoundingBox) {
     // widening of the hull (perimeter 1.3 m x ~5 mm / 0.12 m^2 = +0.05 at most).
     EXPECT_GT(c.fill, 0.87);
     EXPECT_LT(c.fill, EnvelopeConfig{}.min_fill);
+}
+
+TEST(FitEnclosingCuboid, StepFillingItsFootprintIsIrregularByItsTop) {
+    // A 0.4 x 0.3 x 0.2 carton with a 5 cm panel standing 0.2 m higher along one end (an open
+    // flap): the footprint is a full rectangle, but the top covers only the panel's strip.
+    const double l = 0.40, w = 0.30, h = 0.20;
+    const std::vector<Block> blocks = {{-l / 2, l / 2, -w / 2, w / 2, h},
+                                       {-l / 2, -l / 2 + 0.05, -w / 2, w / 2, 2.0 * h}};
+    const Fitted f = Fit(SampleBlocks(blocks, 0.0, 0.3, {0.0, 0.0}, 6));
+    ASSERT_TRUE(f.cuboid.ok()) << f.cuboid.error().message;
+    const EnclosingCuboid& c = *f.cuboid;
+    EXPECT_FALSE(c.cuboid);
+    EXPECT_GT(c.fill, EnvelopeConfig{}.min_fill);
+    EXPECT_LT(c.top_cover, 0.3);
+    EXPECT_NEAR(c.length_m, l, 0.003);
+    EXPECT_NEAR(c.width_m, w, 0.003);
+    EXPECT_NEAR(c.height_m, 2.0 * h, 0.003);
 }
 
 TEST(FitEnclosingCuboid, LShapeIsIrregularAtTwoAndAHalfMillimetresOfNoise) {
