@@ -40,10 +40,13 @@ nlohmann::json ToJson(const CalibrationReport& r) {
         {"table_height_m", r.uncertainty.table_height_m},
         {"table_axis_deg", r.uncertainty.table_axis_deg},
         {"depth_offset_m", r.uncertainty.depth_offset_m},
+        {"focal_scale", r.focal_scale_estimated ? nlohmann::json(r.uncertainty.focal_scale)
+                                                : nlohmann::json(nullptr)},
         {"depth_scale", r.depth_scale_estimated ? nlohmann::json(r.uncertainty.depth_scale)
                                                 : nlohmann::json(nullptr)},
     };
     j["depth_scale_estimated"] = r.depth_scale_estimated;
+    j["focal_scale_estimated"] = r.focal_scale_estimated;
     if (r.depth_scale_estimated && r.uncertainty.depth_scale > kPoorlyObservedScaleSigma) {
         j["notes"] = {
             "depth_scale is poorly observed by this session (1-sigma " +
@@ -71,11 +74,12 @@ std::string CalibrationYaml(const CalibrationReport& r) {
                   "  table_center_m: [%.9f, %.9f, %.9f]\n"
                   "  table_axis: [%.9f, %.9f, %.9f]\n"
                   "  depth_offset_m: %.9f\n"
-                  "  depth_scale: %.9f\n",
+                  "  depth_scale: %.9f\n"
+                  "  focal_scale: %.9f\n",
                   r.reference.length_m, r.reference.width_m, r.reference.height_m, r.poses_used,
                   c.table_center_m.x(), c.table_center_m.y(), c.table_center_m.z(),
                   c.table_axis.x(), c.table_axis.y(), c.table_axis.z(), c.depth_offset_m,
-                  c.depth_scale);
+                  c.depth_scale, c.focal_scale);
     return buf;
 }
 

@@ -19,21 +19,31 @@ enum Group { kTable = 0, kPlusU, kMinusU, kPlusV, kMinusV, kTop, kGroups };
 constexpr int kMinGroupPoints = 30;
 
 // One pose's pixels with their back-projection ray already turned into the base frame:
-// base * p = a * z + t0, where z is the corrected depth.
+// base * p = a * z + t0 with a = lateral / focal_scale + axial, where z is the corrected depth:
+// the ray's lateral part (x/z, y/z from the recorded fx, fy) shrinks as the focal length grows,
+// the optical axis does not.
 struct PosePoints {
-    std::vector<Eigen::Vector3d> a;
+    std::vector<Eigen::Vector3d> a;  // lateral part, base frame
     std::vector<double> raw_z;
+    Eigen::Vector3d axial = Eigen::Vector3d::UnitZ();  // the optical axis, base frame
 };
 
-// Table coordinates of a pixel (see JointState).
+// Table coordinates q of pixel k of `pts` (see JointState), and when `ray` is given, dq/dz: how
+// the point moves per metre of corrected depth (the viewing ray in table coordinates).
 template <typename T>
-void TablePoint(const Eigen::Vector3d& a, double raw_z, const Eigen::Vector3d& t0, const T* frame,
-                const T* depth, T* q) {
-    const T z = T(raw_z) * depth[1] + depth[0];
-    const T d[3] = {T(a.x()) * z + T(t0.x()) - frame[2], T(a.y()) * z + T(t0.y()) - frame[3],
-                    T(a.z()) * z + T(t0.z()) - frame[4]};
+void TablePoint(const PosePoints& pts, std::size_t k, const Eigen::Vector3d& t0, const T* frame,
+                const T* depth, T* q, T* ray = nullptr) {
+    const T z = T(pts.raw_z[k]) * depth[1] + depth[0];
+    const Eigen::Vector3d& l = pts.a[k];
+    const Eigen::Vector3d& o = pts.axial;
+    const T inv_focal = T(1.0) / depth[2];
+    const T a[3] = {T(l.x()) * inv_focal + T(o.x()), T(l.y()) * inv_focal + T(o.y()),
+                    T(l.z()) * inv_focal + T(o.z())};
+    const T d[3] = {a[0] * z + T(t0.x()) - frame[2], a[1] * z + T(t0.y()) - frame[3],
+                    a[2] * z + T(t0.z()) - frame[4]};
     const T inverse_tilt[3] = {-frame[0], -frame[1], T(0.0)};
     ceres::AngleAxisRotatePoint(inverse_tilt, d, q);
+    if (ray != nullptr) ceres::AngleAxisRotatePoint(inverse_tilt, a, ray);
 }
 
 // Box coordinates (u along the length, v along the width) of table point q seen at table
@@ -48,6 +58,53 @@ void BoxPoint(const T* q, const T* box, const T* angle, T* u, T* v) {
     const T cb = cos(box[2]), sb = sin(box[2]);
     *u = cb * x0 + sb * y0;
     *v = -sb * x0 + cb * y0;
+}
+
+// The in-plane part of BoxPoint for a direction (no translation): how (u, v) move with q.
+template <typename T>
+void BoxDirection(const T* dq, const T* box, const T* angle, T* du, T* dv) {
+    using std::cos;
+    using std::sin;
+    const T ca = cos(angle[0]), sa = sin(angle[0]);
+    const T x0 = ca * dq[0] + sa * dq[1];
+    const T y0 = -sa * dq[0] + ca * dq[1];
+    const T cb = cos(box[2]), sb = sin(box[2]);
+    *du = cb * x0 + sb * y0;
+    *dv = -sb * x0 + cb * y0;
+}
+
+// How the signed distance outside face `group` changes per metre along the viewing ray.
+template <typename T>
+T FaceSlope(int group, const T& du, const T& dv, const T& dz) {
+    switch (group) {
+        case kPlusU:
+            return du;
+        case kMinusU:
+            return -du;
+        case kPlusV:
+            return dv;
+        case kMinusV:
+            return -dv;
+        default:
+            return dz;
+    }
+}
+
+// A residual in depth along the viewing ray: the distance `r` from the surface over how fast it
+// changes with depth. The sensor's noise is in depth: a distance residual carries it times
+// |slope|, which the focal scale, the tilt and the box's yaw change, so least squares on
+// distances would buy smaller residuals by turning rays grazing (a bias of the order of σ²: a
+// tenth of a per cent of focal scale, a millimetre of offset, at 2 mm of noise). In depth the
+// noise does not depend on the parameters; how large it is at each incidence is the data's to
+// say (DepthWeights). Rays within kMinSlope of grazing are held at that rate.
+constexpr double kMinSlope = 0.2;
+
+template <typename T>
+T DepthResidual(const T& r, const T& slope) {
+    using std::abs;
+    T rate = abs(slope);
+    if (rate < T(kMinSlope)) rate = T(kMinSlope);
+    return r / rate;
 }
 
 // Signed distance outside face `group` of the reference box.
@@ -79,16 +136,16 @@ T FaceDistance(int group, const T& u, const T& v, const T& z, const BoxDimension
 struct TableCost {
     const PosePoints* pts;
     std::vector<int> idx;
+    std::vector<double> weight;  // per point: 1 / its depth noise
     Eigen::Vector3d t0;
-    double weight;
 
     template <typename T>
     bool operator()(const T* frame, const T* depth, T* r) const {
         for (std::size_t i = 0; i < idx.size(); ++i) {
             const auto k = static_cast<std::size_t>(idx[i]);
-            T q[3];
-            TablePoint(pts->a[k], pts->raw_z[k], t0, frame, depth, q);
-            r[i] = T(weight) * q[2];
+            T q[3], ray[3];
+            TablePoint(*pts, k, t0, frame, depth, q, ray);
+            r[i] = T(weight[i]) * DepthResidual(q[2], ray[2]);
         }
         return true;
     }
@@ -107,8 +164,8 @@ struct TableCost {
 struct FaceCost {
     const PosePoints* pts;
     std::vector<int> idx;
+    std::vector<double> weight;  // per point: 1 / its depth noise
     Eigen::Vector3d t0;
-    double weight;
     int group;
     BoxDimensions ref;
 
@@ -116,10 +173,12 @@ struct FaceCost {
     bool operator()(const T* frame, const T* depth, const T* box, const T* angle, T* r) const {
         for (std::size_t i = 0; i < idx.size(); ++i) {
             const auto k = static_cast<std::size_t>(idx[i]);
-            T q[3], u, v;
-            TablePoint(pts->a[k], pts->raw_z[k], t0, frame, depth, q);
+            T q[3], ray[3], u, v, du, dv;
+            TablePoint(*pts, k, t0, frame, depth, q, ray);
             BoxPoint(q, box, angle, &u, &v);
-            r[i] = T(weight) * FaceDistance(group, u, v, q[2], ref);
+            BoxDirection(ray, box, angle, &du, &dv);
+            r[i] = T(weight[i]) * DepthResidual(FaceDistance(group, u, v, q[2], ref),
+                                                FaceSlope(group, du, dv, ray[2]));
         }
         return true;
     }
@@ -129,6 +188,7 @@ struct FaceCost {
 struct Assignment {
     std::array<std::vector<int>, kGroups> idx;
     std::array<std::vector<double>, kGroups> res;
+    std::array<std::vector<double>, kGroups> slope;  // |d residual / d depth|
 };
 
 double RobustSigma(std::vector<double> r) {
@@ -137,6 +197,34 @@ double RobustSigma(std::vector<double> r) {
     auto mid = r.begin() + static_cast<long>(r.size() / 2);
     std::nth_element(r.begin(), mid, r.end());
     return 1.4826 * *mid;
+}
+
+// Per point of one (pose, group): 1 / the robust spread of the depth residuals of the points
+// whose rays meet the surface at a like incidence (kIncidenceBins quantiles of |slope|). A
+// structured-light sensor's depth noise grows toward grazing, a stereo sensor's hardly: the
+// residuals say which, and least squares weighs each point by its own noise.
+constexpr int kIncidenceBins = 4;
+
+std::vector<double> DepthWeights(const std::vector<double>& res, const std::vector<double>& slope,
+                                 double floor) {
+    const std::size_t m = res.size();
+    std::vector<std::size_t> order(m);
+    for (std::size_t i = 0; i < m; ++i) order[i] = i;
+    std::sort(order.begin(), order.end(),
+              [&slope](std::size_t a, std::size_t b) { return slope[a] < slope[b]; });
+    std::vector<double> w(m, 0.0);
+    for (int b = 0; b < kIncidenceBins; ++b) {
+        const std::size_t lo = m * static_cast<std::size_t>(b) / kIncidenceBins;
+        const std::size_t hi = m * static_cast<std::size_t>(b + 1) / kIncidenceBins;
+        std::vector<double> depth;
+        for (std::size_t i = lo; i < hi; ++i) {
+            const std::size_t k = order[i];
+            depth.push_back(res[k]);
+        }
+        const double sigma = std::max(RobustSigma(depth), floor);
+        for (std::size_t i = lo; i < hi; ++i) w[order[i]] = 1.0 / sigma;
+    }
+    return w;
 }
 
 // Assigns every pixel of a pose to the table, one face, or nothing, at the current state.
@@ -148,29 +236,36 @@ Assignment Assign(const PosePoints& pts, const Eigen::Vector3d& t0, const JointS
     const double m = cfg.face_edge_margin_m;
     const double outer2 = cfg.table_ring_outer_m * cfg.table_ring_outer_m;
     for (std::size_t k = 0; k < pts.a.size(); ++k) {
-        double q[3], u, v;
-        TablePoint(pts.a[k], pts.raw_z[k], t0, s.frame, s.depth, q);
+        double q[3], ray[3], u, v, du, dv;
+        TablePoint(pts, k, t0, s.frame, s.depth, q, ray);
         BoxPoint(q, s.box, &angle, &u, &v);
+        BoxDirection(ray, s.box, &angle, &du, &dv);
         const double z = q[2];
         const bool outside_footprint =
             std::abs(u) > hl + cfg.table_ring_inner_m || std::abs(v) > hw + cfg.table_ring_inner_m;
         if (outside_footprint) {
-            if (std::abs(z) < band[kTable] && q[0] * q[0] + q[1] * q[1] < outer2) {
+            const double depth = z / std::max(std::abs(ray[2]), kMinSlope);
+            if (std::abs(depth) < band[kTable] && q[0] * q[0] + q[1] * q[1] < outer2) {
                 out.idx[kTable].push_back(static_cast<int>(k));
-                out.res[kTable].push_back(z);
+                out.res[kTable].push_back(depth);
+                out.slope[kTable].push_back(std::abs(ray[2]));
             }
             continue;
         }
         // Candidate faces: the point lies over the face's interior (edge margins excluded).
         int best = -1;
-        double best_d = 0.0;
+        double best_d = 0.0, best_depth = 0.0;
+        // The band is in depth along the ray (the sensor's error, a flying pixel's too); the
+        // nearest face in space takes the point.
         auto consider = [&](int g, bool inside) {
             if (!inside) return;
             const double d = FaceDistance(g, u, v, z, ref);
-            if (std::abs(d) < band[static_cast<std::size_t>(g)] &&
+            const double depth = d / std::max(std::abs(FaceSlope(g, du, dv, ray[2])), kMinSlope);
+            if (std::abs(depth) < band[static_cast<std::size_t>(g)] &&
                 (best < 0 || std::abs(d) < std::abs(best_d))) {
                 best = g;
                 best_d = d;
+                best_depth = depth;
             }
         };
         const bool side_height = z > m && z < h - m;
@@ -181,7 +276,9 @@ Assignment Assign(const PosePoints& pts, const Eigen::Vector3d& t0, const JointS
         consider(kTop, std::abs(u) < hl - m && std::abs(v) < hw - m);
         if (best >= 0) {
             out.idx[static_cast<std::size_t>(best)].push_back(static_cast<int>(k));
-            out.res[static_cast<std::size_t>(best)].push_back(best_d);
+            out.res[static_cast<std::size_t>(best)].push_back(best_depth);
+            out.slope[static_cast<std::size_t>(best)].push_back(
+                std::abs(FaceSlope(best, du, dv, ray[2])));
         }
     }
     return out;
@@ -220,8 +317,9 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
     for (std::size_t k = 0; k < n; ++k) {
         const CalibrationView& v = views[k];
         pts[k].a.reserve(v.ray.size());
+        pts[k].axial = r0.col(2);
         for (std::size_t i = 0; i < v.ray.size(); ++i) {
-            pts[k].a.push_back(r0 * Eigen::Vector3d(v.ray[i].x(), v.ray[i].y(), 1.0));
+            pts[k].a.push_back(r0 * Eigen::Vector3d(v.ray[i].x(), v.ray[i].y(), 0.0));
             pts[k].raw_z.push_back(v.raw_z_m[i]);
         }
     }
@@ -229,8 +327,8 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
     JointSolution sol;
     sol.state = init;
     JointState& s = sol.state;
-    // Per pose and group: the band of the next assignment and the weight of its residuals.
-    std::vector<std::array<double, kGroups>> band(n), weight(n);
+    // Per pose and group: the band of the next assignment.
+    std::vector<std::array<double, kGroups>> band(n);
     for (std::size_t k = 0; k < n; ++k) band[k].fill(config.initial_band_m);
 
     ceres::Solver::Summary summary;
@@ -242,7 +340,6 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
             for (int g = 0; g < kGroups; ++g) {
                 const double sigma = std::max(
                     RobustSigma(assign[k].res[static_cast<std::size_t>(g)]), config.sigma_floor_m);
-                weight[k][static_cast<std::size_t>(g)] = 1.0 / sigma;
                 band[k][static_cast<std::size_t>(g)] =
                     std::max(config.band_sigmas * sigma, config.min_band_m);
             }
@@ -251,10 +348,11 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
         popt.cost_function_ownership = ceres::TAKE_OWNERSHIP;
         problem = std::make_unique<ceres::Problem>(popt);
         problem->AddParameterBlock(s.frame, 5);
-        problem->AddParameterBlock(s.depth, 2);
-        if (!config.estimate_depth_scale) {
-            problem->SetManifold(s.depth, new ceres::SubsetManifold(2, {1}));
-        }
+        problem->AddParameterBlock(s.depth, 3);
+        std::vector<int> held;
+        if (!config.estimate_depth_scale) held.push_back(1);
+        if (!config.estimate_focal_scale) held.push_back(2);
+        if (!held.empty()) problem->SetManifold(s.depth, new ceres::SubsetManifold(3, held));
         problem->AddParameterBlock(s.box, 3);
         for (std::size_t k = 0; k < n; ++k) problem->AddParameterBlock(&s.angle_rad[k], 1);
         problem->SetParameterBlockConstant(&s.angle_rad[0]);
@@ -266,16 +364,18 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
                 const std::vector<int>& idx = assign[k].idx[gi];
                 if (static_cast<int>(idx.size()) < kMinGroupPoints) continue;
                 const int m = static_cast<int>(idx.size());
+                std::vector<double> w = DepthWeights(assign[k].res[gi], assign[k].slope[gi],
+                                                     config.sigma_floor_m);
                 if (g == kTable) {
-                    auto* f = new TableCost{&pts[k], idx, t0, weight[k][gi]};
+                    auto* f = new TableCost{&pts[k], idx, std::move(w), t0};
                     problem->AddResidualBlock(
-                        new ceres::AutoDiffCostFunction<TableCost, ceres::DYNAMIC, 5, 2>(f, m),
+                        new ceres::AutoDiffCostFunction<TableCost, ceres::DYNAMIC, 5, 3>(f, m),
                         nullptr, s.frame, s.depth);
                     sol.table_points += m;
                 } else {
-                    auto* f = new FaceCost{&pts[k], idx, t0, weight[k][gi], g, reference};
+                    auto* f = new FaceCost{&pts[k], idx, std::move(w), t0, g, reference};
                     problem->AddResidualBlock(
-                        new ceres::AutoDiffCostFunction<FaceCost, ceres::DYNAMIC, 5, 2, 3, 1>(f, m),
+                        new ceres::AutoDiffCostFunction<FaceCost, ceres::DYNAMIC, 5, 3, 3, 1>(f, m),
                         nullptr, s.frame, s.depth, s.box, &s.angle_rad[k]);
                     sol.face_points += m;
                 }
@@ -297,9 +397,9 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
         ceres::Solve(opt, problem.get(), &summary);
         spdlog::debug(
             "calibrate: round {}: {} table + {} face points, cost {:.4g} -> {:.4g}, offset "
-            "{:.5f} m",
+            "{:.5f} m, focal scale {:.5f}",
             outer, sol.table_points, sol.face_points, summary.initial_cost, summary.final_cost,
-            s.depth[0]);
+            s.depth[0], s.depth[2]);
         if (!summary.IsSolutionUsable()) {
             return Error{ErrorCode::kNotConverged,
                          "the joint calibration problem did not converge: " + summary.message};
@@ -335,10 +435,11 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
     std::vector<std::pair<const double*, const double*>> blocks = {{s.frame, s.frame},
                                                                    {s.depth, s.depth}};
     const int residuals = problem->NumResiduals();
-    const int params = problem->NumParameters() - (config.estimate_depth_scale ? 0 : 1) - 1;
+    const int params = problem->NumParameters() - (config.estimate_depth_scale ? 0 : 1) -
+                       (config.estimate_focal_scale ? 0 : 1) - 1;
     const double chi2 = residuals > params ? 2.0 * summary.final_cost / (residuals - params) : 1.0;
     if (covariance.Compute(blocks, problem.get())) {
-        double cf[25], cd[4];
+        double cf[25], cd[9];
         covariance.GetCovarianceBlock(s.frame, s.frame, cf);
         covariance.GetCovarianceBlock(s.depth, s.depth, cd);
         const Eigen::Map<const Eigen::Matrix<double, 5, 5, Eigen::RowMajor>> f(cf);
@@ -347,7 +448,9 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
         sol.sigma_height_m = std::sqrt(chi2 * std::max(0.0, f(4, 4)));
         sol.sigma_depth_offset_m = std::sqrt(chi2 * std::max(0.0, cd[0]));
         sol.sigma_depth_scale =
-            config.estimate_depth_scale ? std::sqrt(chi2 * std::max(0.0, cd[3])) : 0.0;
+            config.estimate_depth_scale ? std::sqrt(chi2 * std::max(0.0, cd[4])) : 0.0;
+        sol.sigma_focal_scale =
+            config.estimate_focal_scale ? std::sqrt(chi2 * std::max(0.0, cd[8])) : 0.0;
     } else {
         spdlog::warn("calibrate: the covariance of the estimate could not be computed");
     }
@@ -358,6 +461,7 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
     sol.calibration.table_axis = table_to_cam.linear().col(2).normalized();
     sol.calibration.depth_offset_m = s.depth[0];
     sol.calibration.depth_scale = s.depth[1];
+    sol.calibration.focal_scale = s.depth[2];
     return sol;
 }
 

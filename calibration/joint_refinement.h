@@ -1,12 +1,16 @@
 #pragma once
 // The joint calibration problem (Ceres): the table frame (axis tilt and centre), the depth offset
-// (and optionally the depth scale), the reference box's place on the table and small per-pose
+// (and optionally the depth scale), the lens's focal scale, the reference box's place on the table and small per-pose
 // turntable angle corrections, solved together so that
 //   - the table-top points around the box lie on the table plane z = 0, and
 //   - the box points of every pose, turned back by the pose's angle about the axis, lie on the
 //     faces of a box of the REFERENCE size standing on the table.
 // The reference size is what makes the depth offset observable: a wrong offset scales the
 // cloud by about (1 + offset error / distance), so the faces cannot all meet the known box.
+// The focal scale is told apart from it because the two stretch the box differently as the
+// table turns it: the focal length scales across the line of sight (a face seen edge-on, the
+// top's extent across the image), the depth offset along it (a face seen frontally moves toward
+// the camera, the far and near edges of the top apart), and every side is seen both ways.
 // Faces are located by whole-face least squares, never by extreme points.
 
 #include <Eigen/Geometry>
@@ -19,7 +23,8 @@
 
 namespace boxd {
 
-// One pose's candidate pixels: back-projection ray (x/z, y/z) and the averaged raw z-depth.
+// One pose's candidate pixels: back-projection ray (x/z, y/z, from the recorded fx, fy without
+// any focal scale) and the averaged raw z-depth.
 struct CalibrationView {
     std::vector<Eigen::Vector2f> ray;
     std::vector<float> raw_z_m;
@@ -36,6 +41,7 @@ struct JointRefinementConfig {
     int outer_iterations = 4;
     int max_solver_iterations = 50;
     bool estimate_depth_scale = false;
+    bool estimate_focal_scale = true;
     int threads = 2;
 };
 
@@ -45,7 +51,7 @@ struct JointRefinementConfig {
 struct JointState {
     Eigen::Isometry3d base = Eigen::Isometry3d::Identity();
     double frame[5] = {0, 0, 0, 0, 0};  // tilt_x, tilt_y (rad), center x, y, z (m)
-    double depth[2] = {0.0, 1.0};       // depth offset (m), depth scale
+    double depth[3] = {0.0, 1.0, 1.0};  // depth offset (m), depth scale, focal scale
     double box[3] = {0, 0, 0};          // box centre x, y (m) and yaw (rad) at pose 0
     std::vector<double> angle_rad;      // table angle of each pose (ccw); pose 0 held
 };
@@ -59,6 +65,7 @@ struct JointSolution {
     double sigma_axis_deg = 0.0;
     double sigma_depth_offset_m = 0.0;
     double sigma_depth_scale = 0.0;
+    double sigma_focal_scale = 0.0;
     long table_points = 0;
     long face_points = 0;
     double table_rms_m = 0.0;

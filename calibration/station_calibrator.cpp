@@ -116,6 +116,7 @@ std::vector<CalibrationView> CollectViews(const std::vector<DepthMap>& depths,
                                           const BoxDimensions& ref, const CalibrationConfig& cfg) {
     const CameraIntrinsics& cam = session.camera;
     const StationCalibration& recorded = session.calibration;
+    const CameraIntrinsics lens = recorded.Lens(cam);
     const double reach =
         est.box.center_m.norm() + 0.5 * std::hypot(ref.length_m, ref.width_m) + 0.05;
     const double radius = std::max(cfg.table_ring_outer_m + 0.02, reach);
@@ -128,7 +129,7 @@ std::vector<CalibrationView> CollectViews(const std::vector<DepthMap>& depths,
                 const float raw = d.at(u, v);
                 if (raw <= 0.0f) continue;
                 const Eigen::Vector3d p =
-                    est.camera_to_table * cam.BackProject(u, v, recorded.CorrectDepth(raw));
+                    est.camera_to_table * lens.BackProject(u, v, recorded.CorrectDepth(raw));
                 if (p.z() < zmin || p.z() > zmax || p.head<2>().norm() > radius) continue;
                 out[k].ray.emplace_back(static_cast<float>((u - cam.cx) / cam.fx),
                                         static_cast<float>((v - cam.cy) / cam.fy));
@@ -215,6 +216,7 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
     init.base = est->camera_to_table;
     init.depth[0] = session.calibration.depth_offset_m;
     init.depth[1] = session.calibration.depth_scale;
+    init.depth[2] = session.calibration.focal_scale;
     init.box[0] = est->box.center_m.x();
     init.box[1] = est->box.center_m.y();
     init.box[2] = std::atan2(est->box.length_axis.y(), est->box.length_axis.x());
@@ -231,6 +233,7 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
     jc.outer_iterations = config.outer_iterations;
     jc.max_solver_iterations = config.max_solver_iterations;
     jc.estimate_depth_scale = config.estimate_depth_scale;
+    jc.estimate_focal_scale = config.estimate_focal_scale;
     jc.threads = config.measure.threads;
     auto sol = RefineJointly(views, session.camera, ref, init, jc);
     if (!sol) return sol.error();
@@ -248,8 +251,10 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
 
     report.calibration = sol->calibration;
     report.depth_scale_estimated = config.estimate_depth_scale;
+    report.focal_scale_estimated = config.estimate_focal_scale;
     report.uncertainty = {sol->sigma_center_m, sol->sigma_height_m, sol->sigma_axis_deg,
-                          sol->sigma_depth_offset_m, sol->sigma_depth_scale};
+                          sol->sigma_depth_offset_m, sol->sigma_depth_scale,
+                          sol->sigma_focal_scale};
     report.poses_used = n;
     report.table_points = sol->table_points;
     report.face_points = sol->face_points;

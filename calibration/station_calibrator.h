@@ -29,6 +29,8 @@ struct CalibrationConfig {
     // The depth scale is only observable with a second reference or distance; off by default,
     // and then held at the session's value.
     bool estimate_depth_scale = false;
+    // The lens's focal scale is estimated unless held (a lens already calibrated elsewhere).
+    bool estimate_focal_scale = true;
     // Joint refinement.
     int pixel_stride = 2;              // every n-th pixel of each averaged depth map is used
     double table_ring_inner_m = 0.03;  // table points at least this far outside the box ...
@@ -58,19 +60,21 @@ struct CalibrationUncertainty {
     double table_axis_deg = 0.0;  // tilt (larger principal sigma)
     double depth_offset_m = 0.0;
     double depth_scale = 0.0;  // 0 when the scale is held
+    double focal_scale = 0.0;  // 0 when the focal scale is held
 };
 
 struct CalibrationReport {
     StationCalibration calibration;  // the estimate (SPEC section 3 calibration block)
     StationCalibration recorded;     // what the session was captured with
     bool depth_scale_estimated = false;
+    bool focal_scale_estimated = true;
     CalibrationUncertainty uncertainty;
     // Quality figures.
     int poses_used = 0;
     long table_points = 0;
     long face_points = 0;
-    double table_rms_m = 0.0;       // RMS distance of the table points to the fitted plane
-    double face_rms_m = 0.0;        // RMS distance of the face points to the reference box model
+    double table_rms_m = 0.0;       // RMS depth residual (along the rays) of the table points
+    double face_rms_m = 0.0;        // ... and of the face points to the reference box model
     BoxDimensions reference;        // stated size (length >= width)
     BoxDimensions measured_before;  // measured with the recorded calibration
     std::vector<double> pose_angle_corrections_deg;  // estimated turntable angle errors

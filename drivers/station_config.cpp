@@ -218,6 +218,7 @@ Result<StationCalibration> ParseCalibration(const YAML::Node& node) {
                               {"table_axis", Vector3(c.table_axis)},
                               {"depth_offset_m", Value(c.depth_offset_m)},
                               {"depth_scale", Value(c.depth_scale)},
+                              {"focal_scale", Value(c.focal_scale)},
                           });
         !st) {
         return st.error();
@@ -259,17 +260,40 @@ Result<StationConfig> ParseStationConfig(const YAML::Node& document) {
     return config;
 }
 
-Result<StationConfig> LoadStationConfig(const std::filesystem::path& path) {
-    YAML::Node root;
+namespace {
+
+// Returns the YAML document at `path` (`what` names it in the error: "config", "calibration").
+Result<YAML::Node> LoadYaml(const std::filesystem::path& path, const std::string& what) {
     try {
-        root = YAML::LoadFile(path.string());
+        return YAML::LoadFile(path.string());
     } catch (const YAML::BadFile&) {
-        return Error{ErrorCode::kInvalidInput, path.string() + ": cannot read the config file"};
+        return Error{ErrorCode::kInvalidInput, path.string() + ": cannot read the " + what + " file"};
     } catch (const YAML::Exception& e) {
         return Error{ErrorCode::kInvalidInput,
                      path.string() + ": line " + std::to_string(e.mark.line + 1) + ": " + e.msg};
     }
-    auto config = ParseStationConfig(root);
+}
+
+}  // namespace
+
+Result<StationCalibration> LoadCalibrationFile(const std::filesystem::path& path) {
+    auto root = LoadYaml(path, "calibration");
+    if (!root) return root.error();
+    const YAML::Node& doc = *root;  // const: lookups must not add keys
+    if (!doc.IsMap() || !doc["calibration"]) {
+        return Error{ErrorCode::kInvalidInput,
+                     path.string() + ": calibration: missing (a file written by `boxd calibrate "
+                                     "--out`, or a station config, holds a calibration: section)"};
+    }
+    auto c = ParseCalibration(doc["calibration"]);
+    if (!c) return Error{ErrorCode::kInvalidInput, path.string() + ": " + c.error().message};
+    return c;
+}
+
+Result<StationConfig> LoadStationConfig(const std::filesystem::path& path) {
+    auto root = LoadYaml(path, "config");
+    if (!root) return root.error();
+    auto config = ParseStationConfig(*root);
     if (!config)
         return Error{ErrorCode::kInvalidInput, path.string() + ": " + config.error().message};
     // A relative replay session path is relative to the config file, not the working folder.

@@ -41,8 +41,13 @@ Result<CameraConfig> ParseCameraConfig(const YAML::Node& node);
 // Returns the capture config read from a `capture:` node.
 Result<CaptureConfig> ParseCaptureConfig(const YAML::Node& node);
 // Returns the calibration read from a `calibration:` node (table_center_m, table_axis,
-// depth_offset_m, depth_scale; the same fields as a session's calibration block).
+// depth_offset_m, depth_scale, focal_scale; the same fields as a session's calibration block).
 Result<StationCalibration> ParseCalibration(const YAML::Node& node);
+
+// Returns the `calibration:` section of the YAML (or JSON) file at `path`: what `boxd calibrate
+// --out` writes, a station config, or `boxd calibrate`'s report. INVALID_INPUT naming the file
+// and the field when it cannot be read or holds no valid calibration.
+Result<StationCalibration> LoadCalibrationFile(const std::filesystem::path& path);
 
 // Top-level sections that belong to other parts of boxd (the daemon's) and are skipped here.
 inline const std::vector<std::string> kOtherConfigSections = {"server", "storage", "pipeline",

@@ -20,6 +20,9 @@ Status StationCalibration::Validate(const std::string& where) const {
     if (!std::isfinite(depth_scale) || depth_scale < 0.5 || depth_scale > 2.0) {
         return bad("depth_scale", "must be a finite number in 0.5..2");
     }
+    if (!std::isfinite(focal_scale) || focal_scale < 0.8 || focal_scale > 1.25) {
+        return bad("focal_scale", "must be a finite number in 0.8..1.25");
+    }
     return OkStatus();
 }
 

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <string>
 
+#include "pipeline/camera.h"
 #include "pipeline/result.h"
 
 namespace boxd {
@@ -14,12 +15,23 @@ struct StationCalibration {
     Eigen::Vector3d table_axis{0.0, -0.866025, -0.5};  // unit, camera frame, pointing up
     double depth_offset_m = 0.0;  // corrected z = raw z * depth_scale + depth_offset_m
     double depth_scale = 1.0;
+    // The lens: the focal lengths used are the camera's recorded fx, fy times this (factory
+    // intrinsics are often a per cent off, which stretches every lateral size by as much).
+    double focal_scale = 1.0;
 
     // Returns an error naming the first invalid field (prefixed with `where`), or Ok.
     Status Validate(const std::string& where = "calibration") const;
 
     // Returns the depth after the depth correction.
     double CorrectDepth(double raw_z_m) const { return raw_z_m * depth_scale + depth_offset_m; }
+
+    // Returns `camera` with the focal lengths this calibration uses.
+    CameraIntrinsics Lens(const CameraIntrinsics& camera) const {
+        CameraIntrinsics c = camera;
+        c.fx *= focal_scale;
+        c.fy *= focal_scale;
+        return c;
+    }
 
     // Returns the rigid transform camera -> table frame (origin at the table centre, +z along the
     // axis). The table x axis is the camera x axis projected onto the table plane (camera y when x

@@ -49,7 +49,8 @@ json ToJson(const StationCalibration& c) {
     return {{"table_center_m", Vec3(c.table_center_m)},
             {"table_axis", Vec3(c.table_axis)},
             {"depth_offset_m", c.depth_offset_m},
-            {"depth_scale", c.depth_scale}};
+            {"depth_scale", c.depth_scale},
+            {"focal_scale", c.focal_scale}};
 }
 
 Result<StationCalibration> StationCalibrationFromJson(const json& j, const std::string& where) {
@@ -64,7 +65,8 @@ Result<StationCalibration> StationCalibrationFromJson(const json& j, const std::
         *dst = *v;
     }
     for (const auto& [key, dst, required] : {std::tuple{"depth_offset_m", &c.depth_offset_m, true},
-                                             std::tuple{"depth_scale", &c.depth_scale, false}}) {
+                                             std::tuple{"depth_scale", &c.depth_scale, false},
+                                             std::tuple{"focal_scale", &c.focal_scale, false}}) {
         auto m = Member(j, where, key, required);
         if (!m) return m.error();
         if (*m == nullptr) continue;

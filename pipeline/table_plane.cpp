@@ -58,11 +58,12 @@ Status TablePlaneConfig::Validate() const {
 Points BackProjectDepth(const DepthMap& depth, const CameraIntrinsics& camera,
                         const StationCalibration& calibration, int stride) {
     Points out;
+    const CameraIntrinsics lens = calibration.Lens(camera);
     for (int y = 0; y < depth.height; y += stride) {
         for (int x = 0; x < depth.width; x += stride) {
             const float z = depth.at(x, y);
             if (z <= 0.0f) continue;
-            out.push_back(camera.BackProject(x, y, calibration.CorrectDepth(z)).cast<float>());
+            out.push_back(lens.BackProject(x, y, calibration.CorrectDepth(z)).cast<float>());
         }
     }
     return out;

@@ -42,8 +42,9 @@ SegmentedView SegmentView(const DepthMap& depth, const CameraIntrinsics& camera,
     const float zmax = static_cast<float>(config.max_height_m);
     const int m = config.border_margin_px;
     // Per-row back-projection factors: x = (u - cx) / fx * z.
-    const float inv_fx = static_cast<float>(1.0 / camera.fx);
-    const float inv_fy = static_cast<float>(1.0 / camera.fy);
+    const CameraIntrinsics lens = calibration.Lens(camera);
+    const float inv_fx = static_cast<float>(1.0 / lens.fx);
+    const float inv_fy = static_cast<float>(1.0 / lens.fy);
     for (int v = 0; v < depth.height; ++v) {
         const float ry = (static_cast<float>(v) - static_cast<float>(camera.cy)) * inv_fy;
         for (int u = 0; u < depth.width; ++u) {

@@ -19,6 +19,7 @@ struct CalibrateOptions {
     std::vector<double> reference;
     std::string out;
     bool estimate_depth_scale = false;
+    bool hold_focal_scale = false;
 };
 
 int RunCalibrate(const CalibrateOptions& opt) {
@@ -27,6 +28,7 @@ int RunCalibrate(const CalibrateOptions& opt) {
     const BoxDimensions reference{opt.reference[0], opt.reference[1], opt.reference[2]};
     CalibrationConfig config;
     config.estimate_depth_scale = opt.estimate_depth_scale;
+    config.estimate_focal_scale = !opt.hold_focal_scale;
     // A refusal (too few poses, table not visible, wrong reference, box moved, no convergence)
     // is a problem of the input session: its category makes it exit 2 with the code in the line.
     auto report = CalibrateStation(*session, reference, config);
@@ -65,6 +67,9 @@ void AddCalibrate(CLI::App& app, Runner& run) {
     sub->add_option("--out", opt->out,
                     "write the calibration file (YAML: a `calibration:` section for the station "
                     "config)");
+    sub->add_flag("--hold-focal-scale", opt->hold_focal_scale,
+                  "keep the session's focal_scale (a lens calibrated elsewhere) instead of "
+                  "estimating it");
     sub->add_flag("--estimate-depth-scale", opt->estimate_depth_scale,
                   "also estimate the depth scale (only observable with references at several "
                   "distances; held at the recorded value otherwise)");

@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include "daemon/cli/cli.h"
+#include "drivers/station_config.h"
 #include "pipeline/measure_pipeline.h"
 #include "pipeline/ply_writer.h"
 #include "pipeline/session_io.h"
@@ -16,11 +17,21 @@ struct MeasureOptions {
     std::string session;
     std::string method = "footprint";
     std::string cloud;
+    std::string calibration;
 };
 
 int RunMeasure(const MeasureOptions& opt) {
     auto session = LoadSession(opt.session);
     if (!session) return Fail(session.error());
+    if (!opt.calibration.empty()) {
+        // A station recalibrated after the capture: its calibration replaces the session's.
+        auto calibration = LoadCalibrationFile(opt.calibration);
+        if (!calibration) {
+            return Fail(Error{ErrorCode::kInvalidInput,
+                              "--calibration: " + calibration.error().message});
+        }
+        session->calibration = *calibration;
+    }
     const BoxMethod method = opt.method == "pca" ? BoxMethod::kPca : BoxMethod::kFootprint;
     // The command line is an edge of the pipeline: it owns the id, the timestamps and the clock.
     const MonotonicMs clock = SteadyClockMs();
@@ -64,6 +75,9 @@ void AddMeasure(CLI::App& app, Runner& run) {
         ->check(CLI::IsMember({"footprint", "pca"}))
         ->capture_default_str();
     sub->add_option("--cloud", opt->cloud, "write the fused cloud (table frame) as a PLY file");
+    sub->add_option("--calibration", opt->calibration,
+                    "a calibration file (what `boxd calibrate --out` writes): replaces the "
+                    "session's calibration block");
     sub->callback([&run, opt] { run = [opt] { return RunMeasure(*opt); }; });
 }
 

@@ -35,7 +35,7 @@ struct SynthOptions {
     double yaw_deg = 0.0;
     std::optional<double> distance_m, elevation_deg, aim_height_m;
     std::optional<double> angle_error_deg, calib_center_error_m, calib_axis_error_deg;
-    std::optional<double> depth_offset_m, calib_depth_offset_error_m;
+    std::optional<double> depth_offset_m, calib_depth_offset_error_m, focal_error_pct;
     std::optional<int> move_at_pose;
     std::vector<double> move_by;
     std::vector<double> angles;
@@ -154,6 +154,7 @@ Result<SyntheticStationConfig> MakeConfig(const SynthOptions& o) {
     if (o.calib_axis_error_deg) c.calib_axis_error_deg = *o.calib_axis_error_deg;
     if (o.depth_offset_m) c.true_depth_offset_m = *o.depth_offset_m;
     if (o.calib_depth_offset_error_m) c.calib_depth_offset_error_m = *o.calib_depth_offset_error_m;
+    if (o.focal_error_pct) c.focal_error_pct = *o.focal_error_pct;
     if (o.move_at_pose) {
         c.moved_at_pose = *o.move_at_pose;
         if (!o.move_by.empty()) {
@@ -235,6 +236,9 @@ void AddSynth(CLI::App& app, Runner& run) {
     sub->add_option("--calib-depth-offset-error-m", o->calib_depth_offset_error_m,
                     "Depth offset error of the recorded calibration (m, signed): it records the "
                     "sensor bias plus this; minus the bias records 0 (depth never calibrated)");
+    sub->add_option("--focal-error-pct", o->focal_error_pct,
+                    "The camera's true focal length is this many per cent longer than the "
+                    "session's fx, fy (the recorded calibration keeps focal_scale 1)");
     sub->add_option("--move-at-pose", o->move_at_pose, "The box is moved from this pose on");
     sub->add_option("--move-by", o->move_by, "The move: DX DY (m) DYAW (deg)")->expected(3);
     sub->add_option("--angles", o->angles,

@@ -80,6 +80,9 @@ SyntheticRayCaster::SyntheticRayCaster(const SyntheticStationConfig& config, dou
       disc_radius_(config.disc_radius_m),
       disc_thickness_(config.disc_thickness_m),
       floor_drop_(config.floor_drop_m) {
+    // The rays leave through the true lens, whose focal lengths the session may not record.
+    camera_.fx *= 1.0 + config.focal_error_pct / 100.0;
+    camera_.fy *= 1.0 + config.focal_error_pct / 100.0;
     const SyntheticCameraFrame frame = MakeSyntheticCameraFrame(config.camera_pose);
     camera_to_table_ = frame.table_to_camera.transpose();
     origin_ = frame.position_m;

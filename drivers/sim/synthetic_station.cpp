@@ -153,6 +153,9 @@ Status SyntheticStationConfig::Validate() const {
         return Bad("calib_depth_offset_error_m",
                    "must be finite and keep the recorded offset within +-0.5 metres");
     }
+    if (!Finite(focal_error_pct) || std::abs(focal_error_pct) > 10.0) {
+        return Bad("focal_error_pct", "must be a finite number of per cent within +-10");
+    }
     if (moved_at_pose) {
         if (*moved_at_pose < 1) return Bad("moved_at_pose", "must be a pose index >= 1");
         if (!Finite(moved_dx_m)) return Bad("moved_dx_m", "must be finite");
@@ -195,6 +198,7 @@ SyntheticScene MakeSyntheticScene(const SyntheticStationConfig& config) {
     truth.table_axis = cam.table_to_camera * Eigen::Vector3d::UnitZ();
     truth.depth_offset_m = config.true_depth_offset_m;
     truth.depth_scale = 1.0;
+    truth.focal_scale = 1.0 + config.focal_error_pct / 100.0;
     scene.true_calibration = truth;
 
     // The recorded calibration: the centre moved by the configured distance in a random
@@ -210,6 +214,7 @@ SyntheticScene MakeSyntheticScene(const SyntheticStationConfig& config) {
         (Eigen::AngleAxisd(config.calib_axis_error_deg * kDegToRad, tilt_axis) * truth.table_axis)
             .normalized();
     recorded.depth_offset_m = truth.depth_offset_m + config.calib_depth_offset_error_m;
+    recorded.focal_scale = 1.0;  // the station trusts the factory intrinsics
     scene.recorded_calibration = recorded;
     return scene;
 }

@@ -83,6 +83,9 @@ struct SyntheticStationConfig {
     // offset, i.e. a station whose depth was already corrected; -true_depth_offset_m records 0,
     // a station that never learnt of its sensor's bias.
     double calib_depth_offset_error_m = 0.0;
+    // The lens: the true focal lengths are this many per cent longer than `camera`'s, which the
+    // session records (a factory calibration a per cent off).
+    double focal_error_pct = 0.0;
     // Optional: the box is pushed by (dx, dy) on the table top and turned by dyaw from this pose
     // on (for OBJECT_MOVED tests).
     std::optional<int> moved_at_pose;

@@ -103,8 +103,10 @@ TEST(CliCalibrate, CalibratesAndTheCalibrationMakesOtherBoxesMeasureRight) {
             .exit_code,
         0);
     const fs::path file = dir / "calibration.yaml";
+    // This station's lens is as recorded: it is held, and the centre, axis and offset are what
+    // is judged (cli_focal_scale_test.cpp estimates the lens too).
     const auto r = RunBoxd({"calibrate", "--session", ref.string(), "--reference", "0.32", "0.26",
-                            "0.30", "--out", file.string()});
+                            "0.30", "--hold-focal-scale", "--out", file.string()});
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const json out = json::parse(r.out);
     const json& cal = out.at("calibration");
@@ -118,6 +120,8 @@ TEST(CliCalibrate, CalibratesAndTheCalibrationMakesOtherBoxesMeasureRight) {
     EXPECT_EQ(out.at("quality").at("poses_used"), 12);
     EXPECT_GT(out.at("uncertainty").at("depth_offset_m").get<double>(), 0.0);
     EXPECT_TRUE(out.at("uncertainty").at("depth_scale").is_null());
+    EXPECT_TRUE(out.at("uncertainty").at("focal_scale").is_null());
+    EXPECT_DOUBLE_EQ(cal.at("focal_scale").get<double>(), 1.0);
 
     // The file holds the same numbers in a `calibration:` section (YAML).
     std::ifstream in(file);

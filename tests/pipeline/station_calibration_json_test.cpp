@@ -17,13 +17,14 @@ StationCalibration Tilted() {
     c.table_axis = Eigen::Vector3d(0.01, -0.85, -0.52).normalized();
     c.depth_offset_m = -0.0031;
     c.depth_scale = 1.002;
+    c.focal_scale = 1.0085;
     return c;
 }
 
 TEST(StationCalibrationJson, RoundTripsEveryField) {
     const StationCalibration c = Tilted();
     const json j = ToJson(c);
-    EXPECT_EQ(j.size(), 4u) << j.dump();
+    EXPECT_EQ(j.size(), 5u) << j.dump();
     EXPECT_EQ(j["table_center_m"], json({0.012, 0.305, 0.842}));
     auto back = StationCalibrationFromJson(j, "calibration");
     ASSERT_TRUE(back.ok()) << back.error().message;
@@ -31,15 +32,18 @@ TEST(StationCalibrationJson, RoundTripsEveryField) {
     EXPECT_EQ(back->table_axis, c.table_axis);
     EXPECT_EQ(back->depth_offset_m, c.depth_offset_m);
     EXPECT_EQ(back->depth_scale, c.depth_scale);
+    EXPECT_EQ(back->focal_scale, c.focal_scale);
 }
 
-TEST(StationCalibrationJson, DepthScaleIsOptional) {
+TEST(StationCalibrationJson, DepthAndFocalScalesAreOptional) {
     json j = ToJson(Tilted());
     j.erase("depth_scale");
-    j["focal_scale"] = 1.0;  // unknown keys are ignored
+    j.erase("focal_scale");
+    j["lens_model"] = "pinhole";  // unknown keys are ignored
     auto c = StationCalibrationFromJson(j, "calibration");
     ASSERT_TRUE(c.ok()) << c.error().message;
     EXPECT_EQ(c->depth_scale, 1.0);
+    EXPECT_EQ(c->focal_scale, 1.0);
 }
 
 TEST(StationCalibrationJson, NamesTheBrokenField) {

@@ -115,6 +115,56 @@ TEST(CliMeasure, InvalidSessionIsBadInput) {
         RunBoxd({"measure", "--session", dir.path().string(), "--method", "median"}).exit_code, 2);
 }
 
+// Writes `text` to `dir`/`name` and returns the path.
+std::filesystem::path WriteFile(const TempDir& dir, const std::string& name,
+                                const std::string& text) {
+    const auto path = dir / name;
+    std::ofstream(path) << text;
+    return path;
+}
+
+TEST(CliMeasure, CalibrationFileReplacesTheSessionsCalibration) {
+    TempDir dir;
+    // The station's lens is 1% longer than recorded: the box reads ~1% large with the session's
+    // calibration, right with a file that knows the lens.
+    const auto session = Synth(dir, "s", {"--dims", "0.4", "0.3", "0.25", "--focal-error-pct", "1",
+                                          "--calib-center-error-m", "0", "--calib-axis-error-deg",
+                                          "0"});
+    const json recorded = json::parse(std::ifstream(session / "session.json"))["calibration"];
+    json lens = recorded;
+    lens["focal_scale"] = 1.01;
+    const auto file = WriteFile(dir, "lens.yaml", "calibration: " + lens.dump() + "\n");
+    const double before = Measure(session, 0)["dimensions"]["length_m"].get<double>();
+    const double after =
+        Measure(session, 0, {"--calibration", file.string()})["dimensions"]["length_m"].get<double>();
+    EXPECT_GT(before - 0.4, 0.002);
+    EXPECT_NEAR(after, 0.4, 0.001);
+}
+
+TEST(CliMeasure, BadCalibrationFileIsBadInputNamingTheField) {
+    TempDir dir;
+    const auto session = Synth(dir, "s", {"--dims", "0.3", "0.2", "0.2"});
+    auto expect_bad = [&](const std::filesystem::path& file, const std::string& names) {
+        const auto r = RunBoxd({"measure", "--session", session.string(), "--calibration",
+                                file.string()});
+        EXPECT_EQ(r.exit_code, 2) << r.out;
+        EXPECT_TRUE(r.out.empty());
+        EXPECT_NE(r.err.find(names), std::string::npos) << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    };
+    expect_bad(dir / "missing.yaml", "missing.yaml");
+    expect_bad(WriteFile(dir, "none.yaml", "turntable: {}\n"), "calibration");
+    expect_bad(WriteFile(dir, "scale.yaml",
+                         "calibration:\n  table_center_m: [0, 0.2, 1.1]\n  table_axis: [0, "
+                         "-0.866025, -0.5]\n  depth_offset_m: 0\n  focal_scale: 3\n"),
+               "calibration.focal_scale");
+    expect_bad(WriteFile(dir, "axis.yaml",
+                         "calibration:\n  table_center_m: [0, 0.2, 1.1]\n  table_axis: [0, 1, 1]\n"
+                         "  depth_offset_m: 0\n"),
+               "calibration.table_axis");
+    expect_bad(WriteFile(dir, "broken.yaml", "calibration: [\n"), "broken.yaml");
+}
+
 TEST(CliMeasure, EmptyTableIsNoObject) {
     TempDir dir;
     // A 2 mm sheet lies below the segmentation height: the table is empty for the pipeline.

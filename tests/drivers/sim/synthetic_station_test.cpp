@@ -34,16 +34,19 @@ struct Sample {
     Eigen::Vector3d table;   // the same point in the table frame of the true calibration
 };
 
-// Returns every valid pixel of `img` back-projected with the intrinsics and the true calibration.
-std::vector<Sample> BackProject(const SyntheticScene& scene, const DepthImage& img) {
-    const CameraIntrinsics& cam = scene.config.camera;
-    const Eigen::Isometry3d to_table = scene.true_calibration.CameraToTable();
+// Returns every valid pixel of `img` back-projected with the intrinsics and the true calibration
+// (its lens included), or with `calibration` when given.
+std::vector<Sample> BackProject(const SyntheticScene& scene, const DepthImage& img,
+                                const StationCalibration* calibration = nullptr) {
+    const StationCalibration& use = calibration ? *calibration : scene.true_calibration;
+    const CameraIntrinsics cam = use.Lens(scene.config.camera);
+    const Eigen::Isometry3d to_table = use.CameraToTable();
     std::vector<Sample> out;
     for (int y = 0; y < img.height; ++y) {
         for (int x = 0; x < img.width; ++x) {
             const std::uint16_t v = img.at(x, y);
             if (v == 0) continue;
-            const double z = scene.true_calibration.CorrectDepth(v * cam.depth_unit_m);
+            const double z = use.CorrectDepth(v * cam.depth_unit_m);
             Sample s;
             s.x = x;
             s.y = y;
@@ -468,6 +471,30 @@ TEST(SyntheticStation, MovedBoxChangesTheViewsFromItsPoseOn) {
               RenderDepthFrame(scene, 1.0, 1, 3).pixels);
 }
 
+TEST(SyntheticStation, FocalErrorIsRenderedThroughTheTrueLens) {
+    // A lens 1.5% longer than the recorded fx, fy: the true lens puts the pixels on the box, the
+    // recorded one spreads them by 1.5% of their distance from the optical axis.
+    SyntheticStationConfig c = ExactStation();
+    c.box = {0.40, 0.25, 0.30, 0.0, 0.0, 10.0};
+    c.calib_center_error_m = 0.0;
+    c.calib_axis_error_deg = 0.0;
+    c.focal_error_pct = 1.5;
+    const SyntheticScene scene = MakeSyntheticScene(c);
+    EXPECT_DOUBLE_EQ(scene.true_calibration.focal_scale, 1.015);
+    EXPECT_DOUBLE_EQ(scene.recorded_calibration.focal_scale, 1.0);
+    const DepthImage img = RenderDepthFrame(scene, 0.0, 1, 0);
+    auto worst = [&](const StationCalibration& cal) {
+        double w = 0.0;
+        for (const Sample& s : BackProject(scene, img, &cal)) {
+            if (s.table.z() < 0.02 || s.table.z() > c.box.height_m - 0.02) continue;  // sides
+            w = std::max(w, std::abs(SignedDistanceToBox(c.box, 0.0, s.table)));
+        }
+        return w;
+    };
+    EXPECT_LT(worst(scene.true_calibration), 0.0005);
+    EXPECT_GT(worst(scene.recorded_calibration), 0.002);
+}
+
 TEST(SyntheticStation, ValidateNamesTheBadField) {
     auto expect_bad = [](const SyntheticStationConfig& c, const std::string& field) {
         const Status st = c.Validate();
@@ -496,6 +523,9 @@ TEST(SyntheticStation, ValidateNamesTheBadField) {
     c = {};
     c.camera.fx = -1.0;
     expect_bad(c, "camera.fx");
+    c = {};
+    c.focal_error_pct = 12.0;
+    expect_bad(c, "focal_error_pct");
     c = {};
     c.angle_error_deg = -0.1;
     expect_bad(c, "angle_error_deg");
