@@ -8,6 +8,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <set>
 
 namespace boxd {
 
@@ -38,9 +39,12 @@ Status ReadMap(const YAML::Node& node, const std::string& prefix,
                const std::map<std::string, Reader>& readers) {
     if (!node || node.IsNull()) return OkStatus();
     if (!node.IsMap()) return KeyError(prefix, "must be a map");
+    std::set<std::string> seen;
     for (const auto& item : node) {
         const std::string name = item.first.Scalar();
         const std::string key = prefix + "." + name;
+        // YAML keeps both of two equal keys; which one counts would be a guess.
+        if (!seen.insert(name).second) return KeyError(key, "given twice");
         const auto it = readers.find(name);
         if (it == readers.end()) return KeyError(key, "unknown key");
         if (auto st = it->second(item.second, key); !st) return st;
@@ -237,6 +241,11 @@ Result<StationConfig> ParseStationConfig(const YAML::Node& document) {
     }
     for (const auto& item : root) {
         const std::string name = item.first.Scalar();
+        if (std::count_if(root.begin(), root.end(), [&name](const auto& other) {
+                return other.first.Scalar() == name;
+            }) > 1) {
+            return KeyError(name, "section given twice");
+        }
         const bool known = name == "turntable" || name == "camera" || name == "capture" ||
                            name == "calibration" ||
                            std::find(kOtherConfigSections.begin(), kOtherConfigSections.end(),

@@ -1,12 +1,13 @@
 #include "pipeline/session_io.h"
 
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <optional>
 #include <thread>
 
+#include "pipeline/png16.h"
 #include "pipeline/station_calibration_json.h"
 
 namespace boxd {
@@ -56,9 +57,13 @@ private:
     fs::path file_;
 };
 
+// Frames per pose: a capture averages a handful; a session claiming thousands would only cost
+// memory (each 640 x 480 frame is 600 kB decoded). SPEC section 3's rules.
+constexpr std::size_t kMaxFramesPerPose = 64;
+
 // A frame path must stay inside the session folder.
 bool IsContainedRelativePath(const std::string& p) {
-    if (p.empty()) return false;
+    if (p.empty() || p.find('\0') != std::string::npos) return false;  // a NUL would cut the path
     const fs::path path(p);
     if (path.is_absolute() || path.has_root_name() || path.has_root_directory()) return false;
     for (const auto& part : path) {
@@ -75,12 +80,15 @@ Result<CameraIntrinsics> ParseCamera(const JsonReader& r, const json& root) {
     for (const char* key : {"width", "height"}) {
         auto m = r.Member(j, "camera", key);
         if (!m) return m.error();
-        if (!(*m)->is_number_integer()) {
-            return SessionError(r.file(), std::string("camera.") + key, "must be an integer");
+        // Checked as 64-bit: 4294967936 must not pass as 640 after a cast to int.
+        if (!(*m)->is_number_integer() || (*m)->get<std::int64_t>() < 1 ||
+            (*m)->get<std::int64_t>() > 8192) {
+            return SessionError(r.file(), std::string("camera.") + key,
+                                "must be an integer in 1..8192");
         }
     }
-    c.width = j["width"].get<int>();
-    c.height = j["height"].get<int>();
+    c.width = static_cast<int>(j["width"].get<std::int64_t>());
+    c.height = static_cast<int>(j["height"].get<std::int64_t>());
     struct Field {
         const char* key;
         double* dst;
@@ -107,24 +115,11 @@ Result<DepthImage> ReadFrame(const fs::path& file, const std::string& field,
                              const CameraIntrinsics& camera) {
     std::error_code ec;
     if (!fs::is_regular_file(file, ec)) return SessionError(file, field, "file not found");
-    const cv::Mat img = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
-    if (img.empty()) return SessionError(file, field, "not a readable image");
-    if (img.depth() != CV_16U || img.channels() != 1) {
-        return SessionError(file, field, "must be a 16-bit unsigned single-channel image");
-    }
-    if (img.cols != camera.width || img.rows != camera.height) {
-        return SessionError(file, field,
-                            "image is " + std::to_string(img.cols) + "x" +
-                                std::to_string(img.rows) + ", camera says " +
-                                std::to_string(camera.width) + "x" + std::to_string(camera.height));
-    }
-    DepthImage out(img.cols, img.rows);
-    for (int y = 0; y < img.rows; ++y) {
-        const auto* row = img.ptr<std::uint16_t>(y);
-        std::copy(row, row + img.cols,
-                  out.pixels.begin() + static_cast<std::ptrdiff_t>(y) * img.cols);
-    }
-    return out;
+    // The camera's size is checked against the PNG header before a pixel is decoded: a header
+    // claiming 65535 x 65535 costs nothing.
+    auto img = ReadPng16(file, camera.width, camera.height);
+    if (!img) return SessionError(file, field, img.error().message);
+    return img;
 }
 
 Result<std::vector<SessionPose>> ParsePoses(const JsonReader& r, const json& root) {
@@ -145,18 +140,24 @@ Result<std::vector<SessionPose>> ParsePoses(const JsonReader& r, const json& roo
         auto frames = r.Member(arr[i], name, "frames");
         if (!frames) return frames.error();
         const json& f = **frames;
-        if (!f.is_array() || f.empty()) {
-            return SessionError(r.file(), name + ".frames", "must be a non-empty array of paths");
+        if (!f.is_array() || f.empty() || f.size() > kMaxFramesPerPose) {
+            return SessionError(r.file(), name + ".frames",
+                                "must be an array of 1 to " + std::to_string(kMaxFramesPerPose) +
+                                    " paths");
         }
         for (std::size_t k = 0; k < f.size(); ++k) {
             const std::string field = name + ".frames[" + std::to_string(k) + "]";
             if (!f[k].is_string()) return SessionError(r.file(), field, "must be a string");
             const std::string p = f[k].get<std::string>();
             if (!IsContainedRelativePath(p)) {
+                std::string shown = p;
+                for (std::size_t at; (at = shown.find('\0')) != std::string::npos;) {
+                    shown.replace(at, 1, "\\0");
+                }
                 return SessionError(r.file(), field,
-                                    "path '" + p +
+                                    "path '" + shown +
                                         "' must be relative and stay inside the session "
-                                        "folder (no absolute paths, no '..')");
+                                        "folder (no absolute paths, no '..', no NUL)");
             }
             out[i].frame_paths.push_back(p);
         }
@@ -215,7 +216,8 @@ Result<Session> LoadSession(const fs::path& dir) {
     json root;
     try {
         root = json::parse(in);
-    } catch (const json::parse_error& e) {
+    } catch (const json::exception& e) {
+        // Syntax errors, and numbers beyond a double's range (1e400).
         return SessionError(file, "", std::string("not valid JSON: ") + e.what());
     }
     JsonReader r(file);
@@ -305,11 +307,7 @@ Status WriteSession(const Session& session, const fs::path& dir) {
     auto encode = [&](std::size_t begin, std::size_t step) {
         for (std::size_t j = begin; j < pngs.size(); j += step) {
             const auto& [file, img] = pngs[j];
-            const cv::Mat mat(img->height, img->width, CV_16UC1,
-                              const_cast<std::uint16_t*>(img->pixels.data()));
-            if (!cv::imwrite(file.string(), mat, {cv::IMWRITE_PNG_COMPRESSION, 1})) {
-                errors[j] = Error{ErrorCode::kIoError, file.string() + ": cannot write PNG"};
-            }
+            if (Status s = WritePng16(file, *img, 1); !s) errors[j] = s.error();
         }
     };
     std::thread helper(encode, 1, 2);

@@ -8,7 +8,9 @@ Status StationCalibration::Validate(const std::string& where) const {
     auto bad = [&](const std::string& field, const std::string& why) -> Status {
         return Error{ErrorCode::kInvalidInput, where + "." + field + ": " + why};
     };
-    if (!table_center_m.allFinite()) return bad("table_center_m", "must be finite");
+    if (!table_center_m.allFinite() || table_center_m.norm() > 10.0) {
+        return bad("table_center_m", "must be finite and within 10 m of the camera");
+    }
     if (!table_axis.allFinite()) return bad("table_axis", "must be finite");
     if (std::abs(table_axis.norm() - 1.0) > 1e-3) {
         return bad("table_axis", "must be a unit vector (|norm - 1| <= 1e-3), norm is " +

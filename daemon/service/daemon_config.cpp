@@ -18,9 +18,12 @@ Error ConfigError(const std::string& key, const std::string& what) {
 Status CheckKeys(const YAML::Node& node, const std::string& section,
                  const std::set<std::string>& known) {
     if (!node.IsMap()) return ConfigError(section, "expected a mapping");
+    std::set<std::string> seen;
     for (const auto& kv : node) {
         const std::string key = kv.first.as<std::string>();
         if (!known.count(key)) return ConfigError(section + "." + key, "unknown key");
+        // YAML keeps both of two equal keys; which one counts would be a guess.
+        if (!seen.insert(key).second) return ConfigError(section + "." + key, "given twice");
     }
     return OkStatus();
 }

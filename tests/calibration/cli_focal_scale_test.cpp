@@ -31,6 +31,9 @@ struct Station {
     std::string noise;
 };
 
+// How ctest lists a case (instead of its bytes).
+void PrintTo(const Station& s, std::ostream* os) { *os << "seed " << s.seed << ", " << s.noise; }
+
 std::vector<std::string> Synth(const Station& s, const fs::path& out,
                                const std::vector<std::string>& dims, const std::string& poses,
                                std::vector<std::string> extra = {}) {

@@ -137,18 +137,36 @@ TEST(SessionIo, RejectsBadIntrinsics) {
         "camera.depth_unit_m");
     EXPECT_MENTIONS(LoadError([](json& j, const fs::path&) { j["camera"]["width"] = -8; }),
                     "camera.width");
+    // 2^32 + 8 would be 8 after a cast to int: refused as out of range, not truncated.
+    EXPECT_MENTIONS(
+        LoadError([](json& j, const fs::path&) { j["camera"]["width"] = 4294967304ULL; }),
+        "camera.width: must be an integer in 1..8192");
+}
+
+// Loads a session whose session.json has fx written as the text `fx` (what a JSON writer of
+// another program could print), returning the loader's answer.
+Result<Session> LoadWithFxText(const test::TempDir& dir, const std::string& fx) {
+    EXPECT_TRUE(WriteSession(SmallSession(), dir.path()).ok());
+    std::string text = ReadJson(dir / "session.json").dump(2);
+    const std::string key = "\"fx\": 570.0";
+    EXPECT_NE(text.find(key), std::string::npos);
+    text.replace(text.find(key), key.size(), "\"fx\": " + fx);
+    std::ofstream(dir / "session.json") << text;
+    return LoadSession(dir.path());
+}
+
+TEST(SessionIo, NumberBeyondADoubleIsInvalidNotInternal) {
+    test::TempDir dir;
+    auto loaded = LoadWithFxText(dir, "1e400");
+    ASSERT_FALSE(loaded.ok());
+    EXPECT_EQ(loaded.error().code, ErrorCode::kInvalidSession);
+    EXPECT_MENTIONS(loaded.error().message, "not valid JSON");
 }
 
 TEST(SessionIo, RejectsNanIntrinsicsWrittenAsText) {
     // JSON has no NaN literal; a writer that prints one produces text the loader must refuse.
     test::TempDir dir;
-    ASSERT_TRUE(WriteSession(SmallSession(), dir.path()).ok());
-    std::string text = ReadJson(dir / "session.json").dump(2);
-    const std::string key = "\"fx\": 570.0";
-    ASSERT_NE(text.find(key), std::string::npos);
-    text.replace(text.find(key), key.size(), "\"fx\": NaN");
-    std::ofstream(dir / "session.json") << text;
-    auto loaded = LoadSession(dir.path());
+    auto loaded = LoadWithFxText(dir, "NaN");
     ASSERT_FALSE(loaded.ok());
     EXPECT_MENTIONS(loaded.error().message, "session.json");
 }
@@ -176,6 +194,12 @@ TEST(SessionIo, RejectsPathsLeavingTheFolder) {
         j["poses"][2]["frames"][0] = "pose_002/../../other/frame_00.png";
     });
     EXPECT_MENTIONS(msg, "poses[2].frames[0]");
+    // A NUL byte would cut the path short of what session.json says.
+    msg = LoadError([](json& j, const fs::path&) {
+        j["poses"][1]["frames"][0] = std::string("pose_001/frame_00.png\0.txt", 26);
+    });
+    EXPECT_MENTIONS(msg, "poses[1].frames[0]");
+    EXPECT_MENTIONS(msg, "frame_00.png\\0.txt");
 }
 
 TEST(SessionIo, RejectsImageOfWrongSize) {

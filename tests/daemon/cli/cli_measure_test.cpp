@@ -165,6 +165,28 @@ TEST(CliMeasure, BadCalibrationFileIsBadInputNamingTheField) {
     expect_bad(WriteFile(dir, "broken.yaml", "calibration: [\n"), "broken.yaml");
 }
 
+TEST(CliMeasure, OversizedFramesAndTooManyFramesAreBadInputNotACrash) {
+    TempDir dir;
+    const auto session = Synth(dir, "s", {"--dims", "0.3", "0.2", "0.2"});
+    json meta = json::parse(std::ifstream(session / "session.json"));
+    const std::string first = meta["poses"][0]["frames"][0].get<std::string>();
+    auto expect_bad = [&](const std::string& names) {
+        const auto r = RunBoxd({"measure", "--session", session.string()});
+        EXPECT_EQ(r.exit_code, 2) << r.err;
+        EXPECT_TRUE(r.out.empty());
+        EXPECT_NE(r.err.find(names), std::string::npos) << r.err;
+    };
+    // 65 frames in one pose: over the limit of 64, refused from session.json alone.
+    json many = meta;
+    for (int k = 0; k < 64; ++k) many["poses"][0]["frames"].push_back(first);
+    std::ofstream(session / "session.json") << many.dump();
+    expect_bad("poses[0].frames: must be an array of 1 to 64 paths");
+    // A frame larger than the camera: its header is enough to refuse it.
+    std::ofstream(session / "session.json") << meta.dump();
+    ASSERT_TRUE(cv::imwrite((session / first).string(), cv::Mat(2000, 3000, CV_16UC1, cv::Scalar(900))));
+    expect_bad("image is 3000x2000, expected 640x480");
+}
+
 TEST(CliMeasure, EmptyTableIsNoObject) {
     TempDir dir;
     // A 2 mm sheet lies below the segmentation height: the table is empty for the pipeline.

@@ -86,6 +86,17 @@ TEST(ServeConfig, BadValuesNameTheKeyAndExitWith2) {
                                      "127.0.0.1:99999", "--data-dir", (dir / "data").string()});
     EXPECT_EQ(bad_listen.exit_code, 2);
     EXPECT_NE(bad_listen.err.find("--listen"), std::string::npos) << bad_listen.err;
+    // A key given twice (YAML keeps both; which would count is a guess) is refused too.
+    std::ifstream in(kSimConfig);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string server = "server:\n";
+    ASSERT_NE(text.find(server), std::string::npos);
+    text.insert(text.find(server) + server.size(), "  max_body_bytes: 65536\n  max_body_bytes: 1024\n");
+    std::ofstream(dir / "twice.yaml") << text;
+    auto twice = test::RunBoxd({"serve", "--config", (dir / "twice.yaml").string(), "--data-dir",
+                                (dir / "data").string()});
+    EXPECT_EQ(twice.exit_code, 2);
+    EXPECT_NE(twice.err.find("server.max_body_bytes"), std::string::npos) << twice.err;
 }
 
 // The whole chain on config/sim.yaml: measure, read back, cloud, bad requests and a refused
