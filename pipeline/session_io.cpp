@@ -182,11 +182,18 @@ Status LoadFrames(const fs::path& dir, const CameraIntrinsics& camera,
             const auto [i, k] = jobs[j];
             const std::string field =
                 "poses[" + std::to_string(i) + "].frames[" + std::to_string(k) + "]";
-            auto img = ReadFrame(dir / poses[i].frame_paths[k], field, camera);
-            if (img) {
-                poses[i].frames[k] = std::move(*img);
-            } else {
-                errors[j] = img.error();
+            // Nothing may leave a worker thread as an exception (std::terminate): memory running
+            // out while decoding is this frame's error like any other.
+            try {
+                auto img = ReadFrame(dir / poses[i].frame_paths[k], field, camera);
+                if (img) {
+                    poses[i].frames[k] = std::move(*img);
+                } else {
+                    errors[j] = img.error();
+                }
+            } catch (const std::exception& e) {
+                errors[j] = SessionError(dir / poses[i].frame_paths[k], field,
+                                         std::string("cannot be decoded: ") + e.what());
             }
         }
     };

@@ -84,6 +84,14 @@ Status ServerConfig::Validate() const {
         // sockaddr_un.sun_path holds 108 bytes including the terminator.
         return ConfigError("server.unix_socket", "path longer than 107 characters");
     }
+    if (unix_socket_mode.size() < 3 || unix_socket_mode.size() > 4 ||
+        unix_socket_mode.find_first_not_of("01234567") != std::string::npos) {
+        return ConfigError("server.unix_socket_mode", "'" + unix_socket_mode +
+                                                          "' is not an octal mode such as 0660");
+    }
+    if (protect_reads && bearer_token.empty()) {
+        return ConfigError("server.protect_reads", "needs server.bearer_token");
+    }
     if (bearer_token.find_first_of(" \t\r\n") != std::string::npos) {
         return ConfigError("server.bearer_token", "must not contain white space");
     }
@@ -103,15 +111,19 @@ Result<ServerConfig> ParseServerConfig(const YAML::Node& node) {
     ServerConfig c;
     if (!node || node.IsNull()) return c;
     if (auto s = CheckKeys(node, "server",
-                           {"listen", "unix_socket", "bearer_token", "max_body_bytes",
-                            "wait_timeout_s", "threads"});
+                           {"listen", "unix_socket", "unix_socket_mode", "unix_socket_group",
+                            "bearer_token", "protect_reads", "max_body_bytes", "wait_timeout_s",
+                            "threads"});
         !s) {
         return s.error();
     }
     long long max_body = static_cast<long long>(c.max_body_bytes);
     for (Status s : {ReadKey(node, "server", "listen", c.listen),
                      ReadKey(node, "server", "unix_socket", c.unix_socket),
+                     ReadKey(node, "server", "unix_socket_mode", c.unix_socket_mode),
+                     ReadKey(node, "server", "unix_socket_group", c.unix_socket_group),
                      ReadKey(node, "server", "bearer_token", c.bearer_token),
+                     ReadKey(node, "server", "protect_reads", c.protect_reads),
                      ReadKey(node, "server", "max_body_bytes", max_body),
                      ReadKey(node, "server", "wait_timeout_s", c.wait_timeout_s),
                      ReadKey(node, "server", "threads", c.threads)}) {

@@ -28,6 +28,9 @@ struct ServerConfig {
     std::string listen = "127.0.0.1:8080";   // TCP address; "" serves the Unix socket only
     std::string unix_socket;                 // optional Unix socket path, instead or as well
     std::string bearer_token;                // when set, POSTs need "Authorization: Bearer <it>"
+    bool protect_reads = false;              // ... and with this, GETs too
+    std::string unix_socket_mode = "0660";   // octal permissions of the socket file
+    std::string unix_socket_group;           // group of the socket file ("" keeps the daemon's)
     std::size_t max_body_bytes = 64 * 1024;  // larger request bodies get 413
     int wait_timeout_s = 600;                // longest a POST /v1/measure?wait=1 blocks
     int threads = 16;                        // HTTP worker threads (a ?wait=1 request holds one)

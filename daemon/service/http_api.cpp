@@ -2,9 +2,12 @@
 
 #include <httplib.h>
 #include <spdlog/spdlog.h>
+#include <grp.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 
@@ -30,6 +33,35 @@ bool TokenEquals(const std::string& a, const std::string& b) {
         diff |= static_cast<unsigned char>(a[i] ^ (i < b.size() ? b[i] : 0));
     }
     return diff == 0;
+}
+
+// Byte ranges a request may ask for in one Range header.
+constexpr int kMaxRanges = 4;
+
+// Returns how many ranges `range` ("bytes=0-9,20-29") asks for (0 without a header).
+int CountRanges(const std::string& range) {
+    if (range.empty()) return 0;
+    return 1 + static_cast<int>(std::count(range.begin(), range.end(), ','));
+}
+
+// Gives the Unix socket at `path` the octal `mode` and, when named, the group `group`: the umask
+// must not decide who may drive the station.
+Status SetSocketAccess(const std::string& path, const std::string& mode, const std::string& group) {
+    const auto bits = static_cast<mode_t>(std::stoul(mode, nullptr, 8));
+    if (::chmod(path.c_str(), bits) != 0) {
+        return Error{ErrorCode::kBindFailed, "server.unix_socket_mode: cannot set " + mode +
+                                                 " on " + path + ": " + std::strerror(errno)};
+    }
+    if (group.empty()) return OkStatus();
+    const struct group* g = ::getgrnam(group.c_str());
+    if (g == nullptr) {
+        return Error{ErrorCode::kBindFailed, "server.unix_socket_group: no group '" + group + "'"};
+    }
+    if (::chown(path.c_str(), static_cast<uid_t>(-1), g->gr_gid) != 0) {
+        return Error{ErrorCode::kBindFailed, "server.unix_socket_group: cannot give " + path +
+                                                 " to " + group + ": " + std::strerror(errno)};
+    }
+    return OkStatus();
 }
 
 }  // namespace
@@ -86,7 +118,16 @@ void HttpApi::Register(httplib::Server& server) {
         if (!req.has_header("Content-Length") && !req.has_header("Transfer-Encoding")) {
             const_cast<Request&>(req).headers.emplace("Content-Length", "0");
         }
-        if (req.method != "POST" || config_.bearer_token.empty()) {
+        // httplib 0.11 builds a multipart answer to a multi-range request in memory, each range
+        // a full copy: a few hundred ranges of one cloud would take gigabytes.
+        if (CountRanges(req.get_header_value("Range")) > kMaxRanges) {
+            const_cast<Request&>(req).ranges.clear();  // the refusal itself is sent whole
+            SetError(res, 416, ErrorCode::kBadRequest,
+                     "at most " + std::to_string(kMaxRanges) + " byte ranges per request");
+            return httplib::Server::HandlerResponse::Handled;
+        }
+        const bool guarded = req.method == "POST" || config_.protect_reads;
+        if (!guarded || config_.bearer_token.empty()) {
             return httplib::Server::HandlerResponse::Unhandled;
         }
         const std::string auth = req.get_header_value("Authorization");
@@ -96,7 +137,9 @@ void HttpApi::Register(httplib::Server& server) {
             return httplib::Server::HandlerResponse::Unhandled;
         }
         res.set_header("WWW-Authenticate", "Bearer");
-        SetError(res, ErrorCode::kUnauthorized, "POST requests need a valid bearer token");
+        SetError(res, ErrorCode::kUnauthorized,
+                 std::string(config_.protect_reads ? "requests" : "POST requests") +
+                     " need a valid bearer token");
         return httplib::Server::HandlerResponse::Handled;
     });
 
@@ -172,6 +215,11 @@ Status HttpApi::Start() {
         }
         servers_.push_back(std::move(server));
         unix_bound_ = true;
+        if (auto s = SetSocketAccess(config_.unix_socket, config_.unix_socket_mode,
+                                     config_.unix_socket_group);
+            !s) {
+            return s.error();
+        }
     }
     for (auto& server : servers_) {
         httplib::Server* s = server.get();

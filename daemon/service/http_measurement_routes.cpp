@@ -44,7 +44,13 @@ void AddMeasurementRoutes(httplib::Server& server, const ApiContext& api) {
                     }
                     Result<MeasurementResult> result =
                         api.service.WaitFor(*id, std::chrono::seconds(api.config.wait_timeout_s));
-                    if (result) {
+                    if (result && result->reason &&
+                        result->reason->code == ErrorCode::kStorageError) {
+                        // Not stored: no place to fetch it from, and the disk is the server's
+                        // problem (507 Insufficient Storage).
+                        res.headers.erase("Location");
+                        SetJson(res, 507, ToJson(*result));
+                    } else if (result) {
                         SetJson(res, 200, ToJson(*result));
                     } else if (result.error().code == ErrorCode::kTimeout) {
                         SetJson(res, 202, json{{"id", *id}});  // still running: poll by id
@@ -75,6 +81,16 @@ void AddMeasurementRoutes(httplib::Server& server, const ApiContext& api) {
     server.Get(R"(/v1/measurements/([^/]+))", Guarded([api](const Request& req, Response& res) {
                    const std::string id = req.matches[1];
                    auto m = id == "last" ? api.store.Last() : api.store.Get(id);
+                   if (m && !*m && id != "last") {
+                       // Not in the store: a recent result that could not be stored says so
+                       // (STORAGE_ERROR) instead of a bare 404 to a client that polls its id.
+                       auto recent = api.service.WaitFor(id, std::chrono::milliseconds(0));
+                       if (recent && recent->reason &&
+                           recent->reason->code == ErrorCode::kStorageError) {
+                           SetJson(res, 507, ToJson(*recent));
+                           return;
+                       }
+                   }
                    if (!m) {
                        SetError(res, m.error());
                    } else if (!*m) {

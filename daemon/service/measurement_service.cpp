@@ -212,8 +212,18 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
     }
     const Status saved = store_.Save(r, out.files);
     store_.RemoveScratchDir(id);
+    if (!saved) {
+        // A result that is not stored is not reported as one: its dimensions cannot be fetched
+        // again, so a client must not bill by them. The service keeps working; the next
+        // measurement is stored again once the disk has room.
+        spdlog::error("measurement {} not stored: {}", id, saved.error().message);
+        r.status = MeasurementStatus::kFailed;
+        r.dimensions.reset();
+        r.uncertainty_m.reset();
+        r.reason = MeasurementReason{ErrorCode::kStorageError,
+                                     "the result could not be stored: " + saved.error().message};
+    }
     LogMeasurement(r);
-    if (!saved) spdlog::error("measurement {} not stored: {}", id, saved.error().message);
     const bool station_ok = station->IsOpen();
     {
         std::lock_guard lock(mutex_);

@@ -1,5 +1,7 @@
 #include "daemon/service/sqlite_db.h"
 
+#include <spdlog/spdlog.h>
+
 #include "daemon/service/measurement_store.h"
 
 namespace boxd {
@@ -17,6 +19,22 @@ Status SqlExec(sqlite3* db, const char* sql) {
         return e;
     }
     return OkStatus();
+}
+
+std::string QuickCheck(sqlite3* db) {
+    SqlStatement check(db, "PRAGMA quick_check(5);");
+    if (!check.prepared()) return "cannot run quick_check: " + std::string(sqlite3_errmsg(db));
+    std::string found;
+    int rc;
+    while ((rc = check.Step()) == SQLITE_ROW) {
+        if (!found.empty()) found += "\n";
+        found += check.Text(0);
+    }
+    if (rc != SQLITE_DONE) {
+        if (!found.empty()) found += "\n";
+        found += sqlite3_errmsg(db);
+    }
+    return found.empty() ? "ok" : found;
 }
 
 Result<sqlite3*> OpenDatabase(const std::filesystem::path& data_dir,
@@ -50,6 +68,11 @@ Result<sqlite3*> OpenDatabase(const std::filesystem::path& data_dir,
     }
     if (!wal)
         return fail(Error{ErrorCode::kStorageError, path.string() + ": cannot switch to WAL mode"});
+    if (const std::string check = QuickCheck(db); check != "ok") {
+        // Reported, not refused: the rows that can still be read are served; what cannot be
+        // read fails with STORAGE_ERROR when asked for. Restoring a backup is the operator's.
+        spdlog::error("{}: the database is damaged (PRAGMA quick_check): {}", path.string(), check);
+    }
     for (const char* sql : schema) {
         if (auto s = SqlExec(db, sql); !s) {
             return fail(Error{ErrorCode::kStorageError, path.string() + ": " + s.error().message});

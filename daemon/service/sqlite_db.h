@@ -25,6 +25,10 @@ Status SqlExec(sqlite3* db, const char* sql);
 Result<sqlite3*> OpenDatabase(const std::filesystem::path& data_dir,
                               const std::vector<const char*>& schema);
 
+// Returns "ok", or what SQLite's PRAGMA quick_check finds wrong with `db` (its first findings,
+// one per line): a damaged page is said at start rather than met by a later query.
+std::string QuickCheck(sqlite3* db);
+
 // One prepared statement, finalised when it goes out of scope.
 class SqlStatement {
 public:

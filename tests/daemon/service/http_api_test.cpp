@@ -3,6 +3,7 @@
 #include "daemon/service/http_api.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <httplib.h>
 #include <sys/socket.h>
 
@@ -377,6 +378,60 @@ TEST_F(HttpApiTokenTest, ServesTheUnixSocketToo) {
     auto last = client_->Get("/v1/measurements/last");  // and TCP sees the same store
     ASSERT_TRUE(last);
     EXPECT_EQ(Body(last)["id"], Body(ok)["id"]);
+}
+
+TEST_F(HttpApiTokenTest, TheSocketIsReadAndWrittenByOwnerAndGroupOnly) {
+    struct stat st {};
+    ASSERT_EQ(::stat((dir_ / "boxd.sock").c_str(), &st), 0);
+    EXPECT_TRUE(S_ISSOCK(st.st_mode));
+    EXPECT_EQ(st.st_mode & 0777, 0660u);
+}
+
+TEST_F(HttpApiTest, ManyByteRangesAreRefusedBeforeAnyIsBuilt) {
+    // httplib would copy the body once per range into one multipart answer.
+    ExpectError(client_->Get("/v1/status", {{"Range", "bytes=0-,0-,0-,0-,0-"}}), 416,
+                "BAD_REQUEST");
+    auto few = client_->Get("/v1/status", {{"Range", "bytes=0-9,10-19"}});
+    ASSERT_TRUE(few);
+    EXPECT_NE(few->status, 416);
+    auto health = client_->Get("/v1/health");  // and the daemon serves on
+    ASSERT_TRUE(health);
+    EXPECT_EQ(health->status, 200);
+}
+
+class HttpApiProtectedReadsTest : public HttpApiTest {
+protected:
+    void SetUp() override {
+        ServerConfig config;
+        config.listen = "127.0.0.1:0";
+        config.bearer_token = "s3cret";
+        config.protect_reads = true;
+        config.unix_socket = (dir_ / "boxd.sock").string();
+        config.unix_socket_mode = "0600";
+        StartApi(config);
+    }
+};
+
+TEST_F(HttpApiProtectedReadsTest, GetsNeedTheTokenToo) {
+    ExpectError(client_->Get("/v1/status"), 401, "UNAUTHORIZED");
+    ExpectError(client_->Get("/v1/measurements/last"), 401, "UNAUTHORIZED");
+    auto ok = client_->Get("/v1/status", {{"Authorization", "Bearer s3cret"}});
+    ASSERT_TRUE(ok);
+    EXPECT_EQ(ok->status, 200);
+    struct stat st {};
+    ASSERT_EQ(::stat((dir_ / "boxd.sock").c_str(), &st), 0);
+    EXPECT_EQ(st.st_mode & 0777, 0600u);
+}
+
+TEST(ServerConfigValidate, SocketModeAndProtectedReadsNameTheirKey) {
+    ServerConfig c;
+    c.unix_socket_mode = "0999";
+    ASSERT_FALSE(c.Validate());
+    EXPECT_NE(c.Validate().error().message.find("server.unix_socket_mode"), std::string::npos);
+    c = {};
+    c.protect_reads = true;
+    ASSERT_FALSE(c.Validate());
+    EXPECT_NE(c.Validate().error().message.find("server.protect_reads"), std::string::npos);
 }
 
 TEST(HttpApiBind, AnAddressInUseIsAnErrorNamingTheKey) {
