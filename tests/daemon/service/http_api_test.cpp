@@ -339,13 +339,15 @@ TEST_F(HttpApiTest, AbortStopsTheTableAndRecordsTheAbortedMeasurement) {
 
 class HttpApiTokenTest : public HttpApiTest {
 protected:
-    void SetUp() override {
+    // TCP on a free port and a Unix socket in the test's folder, POSTs behind a token.
+    ServerConfig TokenConfig() {
         ServerConfig config;
         config.listen = "127.0.0.1:0";
         config.bearer_token = "s3cret";
         config.unix_socket = (dir_ / "boxd.sock").string();
-        StartApi(config);
+        return config;
     }
+    void SetUp() override { StartApi(TokenConfig()); }
 };
 
 TEST_F(HttpApiTokenTest, PostsNeedTheBearerTokenGetsDoNot) {
@@ -399,14 +401,11 @@ TEST_F(HttpApiTest, ManyByteRangesAreRefusedBeforeAnyIsBuilt) {
     EXPECT_EQ(health->status, 200);
 }
 
-class HttpApiProtectedReadsTest : public HttpApiTest {
+class HttpApiProtectedReadsTest : public HttpApiTokenTest {
 protected:
     void SetUp() override {
-        ServerConfig config;
-        config.listen = "127.0.0.1:0";
-        config.bearer_token = "s3cret";
+        ServerConfig config = TokenConfig();
         config.protect_reads = true;
-        config.unix_socket = (dir_ / "boxd.sock").string();
         config.unix_socket_mode = "0600";
         StartApi(config);
     }
