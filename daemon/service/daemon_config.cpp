@@ -98,6 +98,9 @@ Status ServerConfig::Validate() const {
     if (max_body_bytes < 64) return ConfigError("server.max_body_bytes", "must be at least 64");
     if (wait_timeout_s < 1) return ConfigError("server.wait_timeout_s", "must be at least 1");
     if (threads < 2 || threads > 256) return ConfigError("server.threads", "must be in 2..256");
+    if (max_connections < threads || max_connections > 4096) {
+        return ConfigError("server.max_connections", "must be in server.threads..4096");
+    }
     return OkStatus();
 }
 
@@ -113,7 +116,7 @@ Result<ServerConfig> ParseServerConfig(const YAML::Node& node) {
     if (auto s = CheckKeys(node, "server",
                            {"listen", "unix_socket", "unix_socket_mode", "unix_socket_group",
                             "bearer_token", "protect_reads", "max_body_bytes", "wait_timeout_s",
-                            "threads"});
+                            "threads", "max_connections"});
         !s) {
         return s.error();
     }
@@ -126,7 +129,8 @@ Result<ServerConfig> ParseServerConfig(const YAML::Node& node) {
                      ReadKey(node, "server", "protect_reads", c.protect_reads),
                      ReadKey(node, "server", "max_body_bytes", max_body),
                      ReadKey(node, "server", "wait_timeout_s", c.wait_timeout_s),
-                     ReadKey(node, "server", "threads", c.threads)}) {
+                     ReadKey(node, "server", "threads", c.threads),
+                     ReadKey(node, "server", "max_connections", c.max_connections)}) {
         if (!s) return s.error();
     }
     if (max_body < 0) return ConfigError("server.max_body_bytes", "must not be negative");

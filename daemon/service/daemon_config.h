@@ -34,6 +34,7 @@ struct ServerConfig {
     std::size_t max_body_bytes = 64 * 1024;  // larger request bodies get 413
     int wait_timeout_s = 600;                // longest a POST /v1/measure?wait=1 blocks
     int threads = 16;                        // HTTP worker threads (a ?wait=1 request holds one)
+    int max_connections = 256;               // ... added on demand up to this many connections
 
     // Returns an error naming the first invalid field ("server.<field>: ..."), or Ok.
     Status Validate() const;

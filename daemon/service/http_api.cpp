@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cstring>
 
+#include "daemon/service/connection_pool.h"
 #include "daemon/service/http_response.h"
 #include "daemon/service/http_routes.h"
 #include "daemon/service/service_json.h"
@@ -97,14 +98,18 @@ HttpApi::HttpApi(ServerConfig config, MeasurementService& service, MeasurementSt
 HttpApi::~HttpApi() { Stop(); }
 
 void HttpApi::Register(httplib::Server& server) {
-    const int threads = config_.threads;
-    server.new_task_queue = [threads] { return new httplib::ThreadPool(threads); };
+    const auto threads = static_cast<std::size_t>(config_.threads);
+    const auto max_connections = static_cast<std::size_t>(config_.max_connections);
+    server.new_task_queue = [threads, max_connections] {
+        return new ConnectionPool(threads, max_connections);
+    };
     server.set_payload_max_length(config_.max_body_bytes);
     // httplib's default also sets SO_REUSEPORT, which would let a second daemon bind the same
     // port and silently share its requests; SO_REUSEADDR alone allows quick restarts only.
-    server.set_socket_options([](socket_t sock) {
+    server.set_socket_options([this](socket_t sock) {
         int yes = 1;
         setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof(yes));
+        listening_.push_back(sock);
     });
     server.set_read_timeout(10, 0);
     server.set_write_timeout(10, 0);
@@ -219,6 +224,18 @@ Status HttpApi::Start() {
                                      config_.unix_socket_group);
             !s) {
             return s.error();
+        }
+    }
+    // httplib 0.11 listens with a backlog of 5: connections arriving faster than its accept
+    // loop hands them to threads would have their SYNs dropped (a second's retry each). Calling
+    // listen() again on a listening socket only changes its backlog.
+    for (socket_t sock : listening_) {
+        // Only sockets still listening (an address httplib tried and gave up on was closed, and
+        // its number may be anything's now).
+        int accepting = 0;
+        socklen_t len = sizeof(accepting);
+        if (getsockopt(sock, SOL_SOCKET, SO_ACCEPTCONN, &accepting, &len) == 0 && accepting) {
+            ::listen(sock, SOMAXCONN);
         }
     }
     for (auto& server : servers_) {

@@ -52,6 +52,7 @@ private:
     std::vector<std::thread> threads_;
     int tcp_port_ = 0;
     bool unix_bound_ = false;
+    std::vector<int> listening_;  // the servers' listening sockets
 };
 
 }  // namespace boxd

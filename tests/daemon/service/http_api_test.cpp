@@ -3,6 +3,9 @@
 #include "daemon/service/http_api.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+#include <netinet/in.h>
+#include <arpa/inet.h>
 #include <sys/stat.h>
 #include <httplib.h>
 #include <sys/socket.h>
@@ -399,6 +402,54 @@ TEST_F(HttpApiTest, ManyByteRangesAreRefusedBeforeAnyIsBuilt) {
     auto health = client_->Get("/v1/health");  // and the daemon serves on
     ASSERT_TRUE(health);
     EXPECT_EQ(health->status, 200);
+}
+
+// Opens a TCP connection to 127.0.0.1:`port`; -1 on failure.
+int Connect(int port) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(static_cast<std::uint16_t>(port));
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)) != 0) {
+        ::close(fd);
+        return -1;
+    }
+    return fd;
+}
+
+TEST_F(HttpApiTest, HealthAnswersWhileTwoHundredClientsTrickleHeaders) {
+    // 200 connections (more than the 16 resident workers) that send a request line and then a
+    // header line every 100 ms, never finishing: each holds its connection thread.
+    std::vector<int> slow;
+    for (int i = 0; i < 200; ++i) {
+        const int fd = Connect(api_->tcp_port());
+        ASSERT_GE(fd, 0);
+        const std::string line = "GET /v1/status HTTP/1.1\r\nHost: x\r\n";
+        ASSERT_EQ(::send(fd, line.data(), line.size(), MSG_NOSIGNAL), static_cast<ssize_t>(line.size()));
+        slow.push_back(fd);
+    }
+    std::atomic<bool> stop{false};
+    std::thread trickle([&] {
+        for (int round = 0; !stop && round < 100; ++round) {
+            for (int fd : slow) ::send(fd, "X-Slow: 1\r\n", 11, MSG_NOSIGNAL);
+            std::this_thread::sleep_for(100ms);
+        }
+    });
+    std::this_thread::sleep_for(300ms);
+    httplib::Client probe("127.0.0.1", api_->tcp_port());
+    probe.set_connection_timeout(1, 0);
+    probe.set_read_timeout(1, 0);
+    const auto t0 = std::chrono::steady_clock::now();
+    auto health = probe.Get("/v1/health");
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    stop = true;
+    trickle.join();
+    for (int fd : slow) ::close(fd);
+    ASSERT_TRUE(health) << httplib::to_string(health.error()) << " after " << ms << " ms";
+    EXPECT_EQ(health->status, 200);
+    EXPECT_LT(ms, 1000.0);
 }
 
 class HttpApiProtectedReadsTest : public HttpApiTokenTest {
