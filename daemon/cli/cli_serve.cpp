@@ -1,5 +1,7 @@
 // `boxd serve`: the daemon (SPEC section 6).
 #include <CLI/CLI.hpp>
+#include <malloc.h>
+
 #include <memory>
 
 #include "daemon/cli/cli.h"
@@ -16,7 +18,14 @@ struct ServeOptions {
     std::string data_dir;
 };
 
+// The daemon runs for months: glibc would give each of its many threads (HTTP connections,
+// measurement workers) an arena of its own, up to eight per core, and keep what each once held —
+// the RSS crept from 100 to 290 MB over a dozen measurements. Two arenas serve two cores; the
+// measurement service trims the heap after each measurement (MeasurementService::Run).
+void BoundTheAllocator() { mallopt(M_ARENA_MAX, 2); }
+
 int RunServe(const ServeOptions& o) {
+    BoundTheAllocator();
     ServeOverrides overrides;
     if (!o.listen.empty()) overrides.listen = o.listen;
     if (!o.data_dir.empty()) overrides.data_dir = o.data_dir;

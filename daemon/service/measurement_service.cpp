@@ -1,5 +1,6 @@
 #include "daemon/service/measurement_service.h"
 
+#include <malloc.h>
 #include <spdlog/spdlog.h>
 
 #include <exception>
@@ -245,6 +246,9 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
     }
     finished_cv_.notify_all();
     Notify();
+    // A measurement frees a few hundred megabytes of clouds: hand them back to the system now
+    // rather than keep them for the next one (glibc keeps freed memory in its arenas).
+    malloc_trim(0);
 }
 
 struct MeasurementService::CalibrationJob {
