@@ -22,6 +22,12 @@ std::string ReadFile(const std::filesystem::path& path, bool& ok) {
     return ss.str();
 }
 
+// Whether `r` is a finished result that could not be stored (a full disk): it is answered with
+// 507 Insufficient Storage, never as a stored measurement.
+bool NotStored(const MeasurementResult& r) {
+    return r.reason && r.reason->code == ErrorCode::kStorageError;
+}
+
 }  // namespace
 
 void AddMeasurementRoutes(httplib::Server& server, const ApiContext& api) {
@@ -44,11 +50,8 @@ void AddMeasurementRoutes(httplib::Server& server, const ApiContext& api) {
                     }
                     Result<MeasurementResult> result =
                         api.service.WaitFor(*id, std::chrono::seconds(api.config.wait_timeout_s));
-                    if (result && result->reason &&
-                        result->reason->code == ErrorCode::kStorageError) {
-                        // Not stored: no place to fetch it from, and the disk is the server's
-                        // problem (507 Insufficient Storage).
-                        res.headers.erase("Location");
+                    if (result && NotStored(*result)) {
+                        res.headers.erase("Location");  // there is nothing to fetch there
                         SetJson(res, 507, ToJson(*result));
                     } else if (result) {
                         SetJson(res, 200, ToJson(*result));
@@ -85,8 +88,7 @@ void AddMeasurementRoutes(httplib::Server& server, const ApiContext& api) {
                        // Not in the store: a recent result that could not be stored says so
                        // (STORAGE_ERROR) instead of a bare 404 to a client that polls its id.
                        auto recent = api.service.WaitFor(id, std::chrono::milliseconds(0));
-                       if (recent && recent->reason &&
-                           recent->reason->code == ErrorCode::kStorageError) {
+                       if (recent && NotStored(*recent)) {
                            SetJson(res, 507, ToJson(*recent));
                            return;
                        }
