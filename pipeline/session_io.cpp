@@ -9,6 +9,7 @@
 
 #include "pipeline/png16.h"
 #include "pipeline/station_calibration_json.h"
+#include "pipeline/json_text.h"
 
 namespace boxd {
 
@@ -348,7 +349,7 @@ Status WriteSession(const Session& session, const fs::path& dir) {
     const fs::path tmp = dir / "session.json.tmp";
     {
         std::ofstream out(tmp);
-        out << root.dump(2) << "\n";
+        out << JsonText(root, 2) << "\n";
         if (!out) return Error{ErrorCode::kIoError, tmp.string() + ": cannot write"};
     }
     fs::rename(tmp, file, ec);

@@ -4,6 +4,8 @@
 #   scripts/dev.sh test   install packages, build, run the whole test suite
 #   scripts/dev.sh deps   install packages only
 #   scripts/dev.sh build  build only (into ./build)
+#   scripts/dev.sh sanitize  clang build with ASan + UBSan (./build-sanitize), whole suite
+#   scripts/dev.sh fuzz   the libFuzzer targets, FUZZ_SECONDS (60) each, on tests/fuzz/corpus
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -13,7 +15,7 @@ PACKAGES=(
     libmodbus-dev libopenni2-dev libusb-1.0-0-dev
     libyaml-cpp-dev nlohmann-json3-dev libcpp-httplib-dev libcli11-dev libspdlog-dev
     libsqlite3-dev libsystemd-dev libgtest-dev libembree-dev libpng-dev
-    socat curl
+    socat curl clang libclang-rt-14-dev
 )
 BUILD_DIR=${BUILD_DIR:-build}
 JOBS=${JOBS:-$(nproc)}
@@ -69,8 +71,47 @@ demo() {
 }
 
 run_tests() {
-    cd "$BUILD_DIR"
-    ctest --output-on-failure -j "$JOBS"
+    (cd "$BUILD_DIR" && ctest --output-on-failure -j "$JOBS")
+}
+
+# One clang build serves both: ASan + UBSan everywhere, libFuzzer coverage in the libraries.
+SAN_DIR=${SAN_DIR:-build-sanitize}
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:strict_string_checks=1:check_initialization_order=1:detect_stack_use_after_return=0}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/tests/fuzz/lsan.supp:print_suppressions=0}
+
+sanitize_build() {
+    CC=clang CXX=clang++ cmake -S . -B "$SAN_DIR" -DCMAKE_BUILD_TYPE=Release \
+        -DBOXD_SANITIZE=ON -DBOXD_FUZZ=ON
+    local targets=()
+    for t in "$@"; do targets+=(--target "$t"); done
+    cmake --build "$SAN_DIR" -j "$JOBS" "${targets[@]}"
+}
+
+sanitize() {
+    sanitize_build
+    (cd "$SAN_DIR" && ctest --output-on-failure -j "$JOBS")
+}
+
+fuzz() {
+    sanitize_build fuzz_session fuzz_config fuzz_http
+    local seconds=${FUZZ_SECONDS:-60} status=0
+    for target in session config http; do
+        # New inputs go to a scratch corpus; the seeds in the repository stay as they are.
+        local work="$SAN_DIR/fuzz/$target"
+        mkdir -p "$work/corpus" "$work/findings"
+        echo "dev.sh: fuzz_$target for ${seconds} s"
+        "$SAN_DIR/tests/fuzz/fuzz_$target" -max_total_time="$seconds" -timeout=20 \
+            -rss_limit_mb=2048 -max_len=65536 -print_final_stats=1 \
+            -artifact_prefix="$work/findings/" "$work/corpus" "tests/fuzz/corpus/$target" \
+            > "$work/log" 2>&1 || status=1
+        grep -E "^stat::number_of_executed_units|^stat::peak_rss_mb|^(==|SUMMARY)" "$work/log" || true
+        if [ $status -ne 0 ]; then
+            tail -n 60 "$work/log" >&2
+            echo "dev.sh: fuzz_$target found a failure; the input is in $work/findings" >&2
+            return 1
+        fi
+    done
 }
 
 case "${1:-}" in
@@ -78,5 +119,7 @@ case "${1:-}" in
     test) deps; build; run_tests ;;
     deps) deps ;;
     build) build ;;
-    *) echo "usage: scripts/dev.sh demo|test|deps|build" >&2; exit 2 ;;
+    sanitize) deps; sanitize ;;
+    fuzz) deps; fuzz ;;
+    *) echo "usage: scripts/dev.sh demo|test|deps|build|sanitize|fuzz" >&2; exit 2 ;;
 esac

@@ -9,6 +9,7 @@
 #include "calibration/station_calibrator.h"
 #include "daemon/cli/cli.h"
 #include "pipeline/session_io.h"
+#include "pipeline/json_text.h"
 
 namespace boxd::cli {
 
@@ -43,7 +44,7 @@ int RunCalibrate(const CalibrateOptions& opt) {
                               "--out: cannot write the calibration file " + opt.out});
         }
     }
-    const std::string text = ToJson(*report).dump(2);
+    const std::string text = JsonText(ToJson(*report), 2);
     std::fprintf(stdout, "%s\n", text.c_str());
     std::fflush(stdout);
     return kExitOk;

@@ -5,6 +5,7 @@
 
 #include "daemon/cli/cli.h"
 #include "drivers/usb_devices.h"
+#include "pipeline/json_text.h"
 
 namespace boxd::cli {
 
@@ -26,7 +27,7 @@ int RunDevices(const DevicesOptions& options) {
                                          {"bus", d.bus},
                                          {"address", d.address},
                                          {"port_path", d.port_path}};
-            std::printf("%s\n", line.dump().c_str());
+            std::printf("%s\n", JsonText(line).c_str());
         }
         if (devices->empty()) {
             std::fprintf(stderr, "boxd: %s\n",

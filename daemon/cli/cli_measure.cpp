@@ -8,6 +8,7 @@
 #include "pipeline/measure_pipeline.h"
 #include "pipeline/ply_writer.h"
 #include "pipeline/session_io.h"
+#include "pipeline/json_text.h"
 
 namespace boxd::cli {
 
@@ -51,7 +52,7 @@ int RunMeasure(const MeasureOptions& opt) {
             return Fail(Error{ErrorCode::kInvalidInput, "--cloud: " + s.error().message});
         }
     }
-    const std::string text = ToJson(out->result).dump(2);
+    const std::string text = JsonText(ToJson(out->result), 2);
     std::fprintf(stdout, "%s\n", text.c_str());
     std::fflush(stdout);
     switch (out->result.status) {

@@ -14,6 +14,7 @@
 #include "drivers/driver_registry.h"
 #include "drivers/station_config.h"
 #include "pipeline/session_io.h"
+#include "pipeline/json_text.h"
 
 namespace boxd::cli {
 
@@ -73,7 +74,7 @@ int RunRecord(const RecordOptions& options) {
                                     {"source", session->source},
                                     {"poses", session->poses.size()},
                                     {"frames", frames}};
-    std::printf("%s\n", summary.dump().c_str());
+    std::printf("%s\n", JsonText(summary).c_str());
     return kExitOk;
 }
 

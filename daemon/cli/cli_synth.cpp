@@ -16,6 +16,7 @@
 #include "drivers/sim/synthetic_objects.h"
 #include "drivers/sim/synthetic_station.h"
 #include "pipeline/session_io.h"
+#include "pipeline/json_text.h"
 
 namespace boxd::cli {
 
@@ -204,7 +205,7 @@ int RunSynth(const SynthOptions& o) {
                           {"elapsed_ms", ms(end - start)},
                           {"render_ms", ms(rendered - start)},
                           {"write_ms", ms(end - rendered)}};
-    std::printf("%s\n", summary.dump().c_str());
+    std::printf("%s\n", JsonText(summary).c_str());
     return kExitOk;
 }
 

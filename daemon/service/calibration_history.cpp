@@ -2,6 +2,7 @@
 
 #include "daemon/service/measurement_store.h"
 #include "daemon/service/sqlite_db.h"
+#include "pipeline/json_text.h"
 
 namespace boxd {
 
@@ -51,9 +52,9 @@ Status CalibrationHistory::Record(const CalibrationRecord& r) {
     insert.Bind(2, std::string(r.report ? "ok" : "failed"));
     insert.Bind(3, r.error ? std::string(ErrorCodeName(r.error->code)) : std::string());
     insert.Bind(4, r.error ? r.error->message : std::string());
-    insert.Bind(5, reference.dump());
-    insert.Bind(6, r.report ? report["quality"].dump() : std::string());
-    insert.Bind(7, r.report ? report["calibration"].dump() : std::string());
+    insert.Bind(5, JsonText(reference));
+    insert.Bind(6, r.report ? JsonText(report["quality"]) : std::string());
+    insert.Bind(7, r.report ? JsonText(report["calibration"]) : std::string());
     if (insert.Step() != SQLITE_DONE) return SqlError(db_, "cannot store a calibration");
     SqlStatement trim(
         db_, "DELETE FROM calibrations WHERE seq <= (SELECT max(seq) FROM calibrations) - ?1;");

@@ -11,6 +11,7 @@
 #include "pipeline/ply_writer.h"
 #include "pipeline/session_io.h"
 #include "pipeline/station_calibration_json.h"
+#include "pipeline/json_text.h"
 
 namespace boxd {
 
@@ -225,7 +226,7 @@ Result<CalibrationRun> DeviceStation::Calibrate(const JobContext& ctx,
     const auto tmp = config_.calibration_file.string() + ".tmp";
     {
         std::ofstream file(tmp);
-        file << ToJson(run).dump(2) << "\n";
+        file << JsonText(ToJson(run), 2) << "\n";
         if (!file) return Error{ErrorCode::kStorageError, "cannot write " + tmp};
     }
     std::error_code ec;

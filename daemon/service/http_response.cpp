@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "daemon/service/service_json.h"
+#include "pipeline/json_text.h"
 
 namespace boxd {
 
@@ -14,7 +15,7 @@ using Response = httplib::Response;
 
 void SetError(Response& res, int http_status, ErrorCode code, const std::string& message) {
     res.status = http_status;
-    res.set_content(json{{"error", ToJson(Error{code, message})}}.dump(), "application/json");
+    res.set_content(JsonText(json{{"error", ToJson(Error{code, message})}}), "application/json");
 }
 
 void SetError(Response& res, ErrorCode code, const std::string& message) {
@@ -25,7 +26,7 @@ void SetError(Response& res, const Error& error) { SetError(res, error.code, err
 
 void SetJson(Response& res, int http_status, const json& body) {
     res.status = http_status;
-    res.set_content(body.dump(), "application/json");
+    res.set_content(JsonText(body), "application/json");
 }
 
 httplib::Server::Handler Guarded(std::function<void(const Request&, Response&)> handler) {

@@ -6,6 +6,7 @@
 #include <regex>
 
 #include "daemon/service/sqlite_db.h"
+#include "pipeline/json_text.h"
 
 namespace boxd {
 
@@ -155,7 +156,7 @@ Status MeasurementStore::Save(const MeasurementResult& result, const Measurement
     insert.Bind(3, result.started_at);
     insert.Bind(4, result.finished_at);
     insert.Bind(5, std::string(StatusName(result.status)));
-    insert.Bind(6, ToJson(result).dump());
+    insert.Bind(6, JsonText(ToJson(result)));
     cloud_file ? insert.Bind(7, *cloud_file) : insert.BindNull(7);
     session_dir ? insert.Bind(8, *session_dir) : insert.BindNull(8);
     if (insert.Step() != SQLITE_DONE) return SqlError(db_, "cannot store " + id);

@@ -16,6 +16,7 @@
 
 #include "daemon/service/measurement_service.h"
 #include "daemon/service/measurement_store.h"
+#include "tests/support/scripted_station.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd {
@@ -23,69 +24,6 @@ namespace {
 
 using nlohmann::json;
 using namespace std::chrono_literals;
-
-// A station whose measurement can be held mid-capture until the test releases it.
-class ScriptedStation : public Station {
-public:
-    std::atomic<bool> hold{false};
-    std::atomic<bool> in_capture{false};
-    std::atomic<int> stop_requests{0};
-    std::atomic<bool> fail_next{false};
-
-    Status Open() override {
-        open_ = true;
-        return OkStatus();
-    }
-    bool IsOpen() const override { return open_; }
-    JobOutput Measure(const JobContext& ctx) override {
-        JobOutput out;
-        ctx.progress(JobProgress{"capture", 1, 4});
-        in_capture = true;
-        while (hold && !ctx.cancelled()) std::this_thread::sleep_for(2ms);
-        in_capture = false;
-        if (ctx.cancelled()) {
-            out.result.reason = MeasurementReason{ErrorCode::kCancelled, "capture cancelled"};
-            return out;
-        }
-        if (fail_next.exchange(false)) {
-            open_ = false;
-            out.result.reason = MeasurementReason{ErrorCode::kTurntableError, "sim: stall"};
-            return out;
-        }
-        out.result.status = MeasurementStatus::kOk;
-        out.result.dimensions = MeasuredDimensions{0.4, 0.3, 0.2, 0.024, "footprint"};
-        out.result.quality.poses = 4;
-        out.result.timing_ms["capture"] = 12.0;
-        const auto ply = ctx.scratch_dir / "cloud.ply";
-        std::ofstream(ply) << "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n";
-        out.files.cloud_ply = ply;
-        return out;
-    }
-    Result<CalibrationRun> Calibrate(const JobContext& ctx,
-                                     const BoxDimensions& reference) override {
-        ctx.progress(JobProgress{"capture", 2, 4});
-        in_capture = true;
-        while (hold && !ctx.cancelled()) std::this_thread::sleep_for(2ms);
-        in_capture = false;
-        if (ctx.cancelled()) return Error{ErrorCode::kCancelled, "capture cancelled"};
-        if (reference.height_m > 1.0)
-            return Error{ErrorCode::kWrongReference, "measured 0.2 m high"};
-        return CalibrationRun{CalibrationReport{}, "2026-01-01T00:00:00.000Z", reference};
-    }
-    void RequestStop() override { ++stop_requests; }
-    void Shutdown() override { open_ = false; }
-    DeviceHealth Devices() const override {
-        DeviceHealth devices;
-        devices.turntable.ok = open_.load();
-        return devices;
-    }
-    CalibrationInForce Calibration() const override {
-        return CalibrationInForce{StationCalibration{}, "calibration.json", 42};
-    }
-
-private:
-    std::atomic<bool> open_{false};
-};
 
 class HttpApiTest : public ::testing::Test {
 protected:
@@ -416,6 +354,36 @@ int Connect(int port) {
         return -1;
     }
     return fd;
+}
+
+// Sends `request` (which asks for "Connection: close") on a new connection and returns the
+// whole answer ("" when none came).
+std::string RawExchange(int port, const std::string& request) {
+    const int fd = Connect(port);
+    if (fd < 0) return "";
+    ::send(fd, request.data(), request.size(), MSG_NOSIGNAL);
+    std::string reply;
+    char buf[4096];
+    for (ssize_t n; (n = ::recv(fd, buf, sizeof(buf), 0)) > 0;) reply.append(buf, n);
+    ::close(fd);
+    return reply;
+}
+
+TEST_F(HttpApiTest, PathsThatAreNotUtf8GetTheirErrorAndTheDaemonServesOn) {
+    // Found by tests/fuzz/http_fuzz.cpp: the unknown path, echoed in the error message, is not
+    // UTF-8, and writing the JSON threw out of the handler: std::terminate took the daemon down.
+    for (const char* method : {"GET", "POST"}) {
+        const std::string reply = RawExchange(
+            api_->tcp_port(), std::string(method) + " /v1/meas\xe5ure?wait=1 HTTP/1.1\r\nHost: x\r\n"
+                              "Connection: close\r\nContent-Length: 2\r\n\r\n{}");
+        ASSERT_EQ(reply.rfind("HTTP/1.1 404", 0), 0u) << method << ": " << reply;
+        const json body = json::parse(reply.substr(reply.find("\r\n\r\n") + 4), nullptr, false);
+        ASSERT_TRUE(body.is_object()) << reply;
+        EXPECT_EQ(body["error"]["code"], "NOT_FOUND");
+    }
+    auto health = client_->Get("/v1/health");
+    ASSERT_TRUE(health);
+    EXPECT_EQ(health->status, 200);
 }
 
 TEST_F(HttpApiTest, HealthAnswersWhileTwoHundredClientsTrickleHeaders) {
