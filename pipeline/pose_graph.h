@@ -62,7 +62,8 @@ struct PoseGraphReport {
 // Solves `graph` once with the edges not marked rejected; updates poses and centre offset.
 Status SolvePoseGraph(PoseGraph& graph, const PoseGraphConfig& config);
 
-// Solves, rejects the worst disagreeing edge, and re-solves until every kept edge agrees.
+// Solves, rejects the disagreeing edges that are the worst at their nodes, and re-solves until
+// every kept edge agrees or max_rejection_rounds rounds have rejected.
 Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfig& config);
 
 // Returns the covariance of the solved poses, 3N x 3N in (x, y, yaw) per node (node 0 defines
