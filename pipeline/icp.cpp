@@ -131,6 +131,7 @@ IcpResult AlignIcp(const OrientedPoints& source, const IcpTarget& target, const 
     const Linearization fin = Linearize(source, target, t, config);
     result.transform = t;
     result.correspondences = fin.matched;
+    result.solved = fin.solved;
     result.fitness = static_cast<double>(fin.matched) / static_cast<double>(source.points.size());
     result.rmse = fin.matched > 0 ? std::sqrt(fin.sq_sum / fin.matched) : 0.0;
     const double sigma = std::max(result.rmse, config.sigma_floor_m);

@@ -49,6 +49,9 @@ struct IcpResult {
     Eigen::Matrix3d point_scatter = Eigen::Matrix3d::Zero();
     bool converged = false;
     int correspondences = 0;
+    // Correspondences on upright surfaces, the ones that fix (x, y, yaw); below the config's
+    // min_correspondences the alignment never moved and `transform` is its start.
+    int solved = 0;
     int iterations = 0;
 };
 

@@ -97,7 +97,9 @@ std::vector<PoseEdge> RegisterViewPairs(const std::vector<ViewClouds>& views,
             list[e].first, list[e].second, coarse_iterations[e], r.iterations, r.fitness,
             r.rmse * 1000.0, r.transform.x * 1000.0, r.transform.y * 1000.0,
             r.transform.yaw * 180.0 / M_PI);
-        if (r.correspondences < config.fine.min_correspondences || r.fitness < config.min_fitness ||
+        // An alignment with too few upright correspondences never left its start: its
+        // "measurement" would only repeat the turntable model, as if confirming it.
+        if (r.solved < config.fine.min_correspondences || r.fitness < config.min_fitness ||
             r.rmse > config.max_rmse_m) {
             continue;
         }

@@ -207,5 +207,26 @@ TEST_F(RegisterViewPairsTest, PairThatCannotAlignIsLeftOut) {
     }
 }
 
+TEST_F(RegisterViewPairsTest, PairSharingOnlyTheTopIsLeftOut) {
+    // View 3 keeps only the top face. Horizontal points say nothing about (x, y, yaw), so an
+    // alignment onto or from it cannot move from the turntable model; taken as an edge it would
+    // feed the model back to the pose graph as if a measurement had confirmed it.
+    std::vector<ViewClouds> views = *views_;
+    const RegistrationConfig config;
+    Points top;
+    for (const Eigen::Vector3f& p : BoxView(TrueAngle(3), 103)) {
+        if (p.z() > 0.1495f) top.push_back(p);
+    }
+    views[3] = BuildRegistrationClouds(top, config.coarse_cloud, config.fine_cloud);
+    EdgeStats stats;
+    const std::vector<PoseEdge> edges = RegisterViewPairs(views, *angles_, config, &stats);
+    EXPECT_EQ(stats.attempted, 16);
+    EXPECT_EQ(stats.accepted, 12);
+    for (const PoseEdge& e : edges) {
+        EXPECT_NE(e.from, 3);
+        EXPECT_NE(e.to, 3);
+    }
+}
+
 }  // namespace
 }  // namespace boxd
