@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "tests/support/box_on_turntable.h"
+
 namespace boxd {
 namespace {
 
@@ -18,61 +20,7 @@ constexpr int kViews = 8;
 // The scene: a 0.30 x 0.20 x 0.15 m box standing off the axis at yaw 0.3 rad, turned by the
 // table about a true centre 3 mm / -2 mm off the calibrated axis, by angles that miss the
 // commanded 45-degree steps by up to 0.7 degrees.
-constexpr double kLength = 0.30, kWidth = 0.20, kHeight = 0.15;
-constexpr double kBoxYaw = 0.3;
-const Eigen::Vector2d kBoxCentre(0.03, -0.02);
-const Eigen::Vector2d kTrueCentre(0.003, -0.002);
-const double kAngleErrorDeg[kViews] = {0.0, 0.6, -0.5, 0.7, -0.4, 0.5, -0.6, 0.3};
-constexpr double kNoiseM = 0.0005;  // sensor noise along the surface normal
-constexpr double kStepM = 0.002;    // surface sampling
-
-double Commanded(int k) { return 45.0 * kDeg * k; }
-double TrueAngle(int k) { return Commanded(k) + kAngleErrorDeg[k] * kDeg; }
-
-// Node k's true pose: maps view k's points back into the frame of pose 0.
-Se2 TruePose(int k) { return Se2::RotationAbout(-TrueAngle(k), kTrueCentre); }
-
-// The box's side faces as the camera sees them with the table at `angle`: face f (0: +u,
-// 1: +v, 2: -u, 3: -v) is seen when its outward normal faces the camera (which looks along +y
-// from above) at more than grazing incidence. The top is always seen.
-Eigen::Vector2d FaceNormal(int f, double angle) {
-    const double a = kBoxYaw + angle + f * M_PI / 2;
-    return {std::cos(a), std::sin(a)};
-}
-bool Visible(int f, double angle) { return FaceNormal(f, angle).y() <= -0.1; }
-
-// The points the camera sees of the box with the table at `angle`, in that view's table frame,
-// with kNoiseM of noise along each face's normal.
-Points BoxView(double angle, unsigned seed) {
-    std::mt19937 rng(seed);
-    std::normal_distribution<double> noise(0.0, kNoiseM);
-    const Se2 box_to_view = Se2::RotationAbout(angle, kTrueCentre)
-                                .Compose(Se2{kBoxCentre.x(), kBoxCentre.y(), kBoxYaw});
-    Points pts;
-    auto side = [&](double u, double v, double z, int f) {
-        if (!Visible(f, angle)) return;
-        const Eigen::Vector2d q =
-            box_to_view.Apply(Eigen::Vector2d(u, v)) + noise(rng) * FaceNormal(f, angle);
-        pts.emplace_back(q.x(), q.y(), z);
-    };
-    for (double z = kStepM / 2; z < kHeight; z += kStepM) {
-        for (double v = -kWidth / 2; v <= kWidth / 2; v += kStepM) {
-            side(kLength / 2, v, z, 0);
-            side(-kLength / 2, v, z, 2);
-        }
-        for (double u = -kLength / 2; u <= kLength / 2; u += kStepM) {
-            side(u, kWidth / 2, z, 1);
-            side(u, -kWidth / 2, z, 3);
-        }
-    }
-    for (double u = -kLength / 2; u <= kLength / 2; u += kStepM) {
-        for (double v = -kWidth / 2; v <= kWidth / 2; v += kStepM) {
-            const Eigen::Vector2d p = box_to_view.Apply(Eigen::Vector2d(u, v));
-            pts.emplace_back(p.x(), p.y(), kHeight + noise(rng));
-        }
-    }
-    return pts;
-}
+const test::BoxOnTurntable kScene{{0.003, -0.002}, {0.0, 0.6, -0.5, 0.7, -0.4, 0.5, -0.6, 0.3}};
 
 struct Scene {
     std::vector<RegistrationClouds> clouds;
@@ -84,9 +32,9 @@ Scene MakeScene(int views) {
     const RegistrationConfig config;
     Scene s;
     for (int k = 0; k < views; ++k) {
-        s.clouds.push_back(BuildRegistrationClouds(BoxView(TrueAngle(k), 200 + k),
+        s.clouds.push_back(BuildRegistrationClouds(kScene.View(kScene.TrueAngle(k), 200 + k),
                                                    config.coarse_cloud, config.fine_cloud));
-        s.commanded.push_back(Commanded(k));
+        s.commanded.push_back(kScene.Commanded(k));
     }
     return s;
 }
@@ -121,7 +69,8 @@ TEST_F(RegisterViewsTest, RecoversTheTrueTurntableAngles) {
     EXPECT_EQ(r->poses[0].y, 0.0);
     EXPECT_EQ(r->poses[0].yaw, 0.0);
     for (int k = 1; k < kViews; ++k) {
-        const Eigen::Vector3d d = Se2Difference(r->poses[static_cast<std::size_t>(k)], TruePose(k));
+        const Eigen::Vector3d d =
+            Se2Difference(r->poses[static_cast<std::size_t>(k)], kScene.TruePose(k));
         // The turntable model misses by up to 0.7 degrees: the budget is far below that.
         EXPECT_LT(std::abs(d.z()), kYawBudgetRad) << "view " << k;
         // The millimetre of a measurement for the rest of the motion (the model is 3.6 mm off
@@ -139,8 +88,11 @@ TEST_F(RegisterViewsTest, DefaultGraphImprovesOnTheTurntableModel) {
     ASSERT_TRUE(r.ok()) << r.error().message;
     ASSERT_EQ(r->poses.size(), static_cast<std::size_t>(kViews));
     for (int k = 1; k < kViews; ++k) {
-        const double error = Se2Difference(r->poses[static_cast<std::size_t>(k)], TruePose(k)).z();
-        EXPECT_LT(std::abs(error), std::abs(kAngleErrorDeg[k]) * kDeg) << "view " << k;
+        const double error =
+            Se2Difference(r->poses[static_cast<std::size_t>(k)], kScene.TruePose(k)).z();
+        EXPECT_LT(std::abs(error),
+                  std::abs(kScene.angle_error_deg[static_cast<std::size_t>(k)]) * kDeg)
+            << "view " << k;
     }
 }
 

@@ -7,6 +7,8 @@
 #include <set>
 #include <utility>
 
+#include "tests/support/box_on_turntable.h"
+
 namespace boxd {
 namespace {
 
@@ -17,71 +19,15 @@ constexpr int kViews = 8;
 // 4 mm / -3 mm off the calibrated axis and by angles that miss the commanded 45-degree steps by
 // up to half a degree. The turntable model is then 4 - 7 mm and up to 0.8 degrees off per pair:
 // ICP has to find the rest.
-const Eigen::Vector2d kTrueCentre(0.004, -0.003);
-const double kAngleErrorDeg[kViews] = {0.0, 0.4, -0.3, 0.5, -0.2, 0.3, -0.4, 0.2};
-
-double Commanded(int k) { return 45.0 * kDeg * k; }
-double TrueAngle(int k) { return Commanded(k) + kAngleErrorDeg[k] * kDeg; }
-
-// Node k's true pose: maps view k back into the frame of pose 0.
-Se2 TruePose(int k) { return Se2::RotationAbout(-TrueAngle(k), kTrueCentre); }
-
-constexpr double kBoxYaw = 0.3;
-
-// The outward normal of side face f of the box (0: +u, 1: +v, 2: -u, 3: -v) in the table frame
-// with the table at `angle`.
-Eigen::Vector2d FaceNormal(int f, double angle) {
-    const double a = kBoxYaw + angle + f * M_PI / 2;
-    return {std::cos(a), std::sin(a)};
-}
-
-// Whether the camera (looking along +y from above) sees side face f with the table at `angle`:
-// it faces the camera, not at grazing incidence.
-bool Visible(int f, double angle) {
-    return FaceNormal(f, angle).dot(Eigen::Vector2d(0.0, -1.0)) >= 0.1;
-}
-
-// The faces of the box the camera sees with the table at `angle`: the top and the visible
-// sides, sampled every 2 mm with 0.5 mm sensor noise along the face normal.
-Points BoxView(double angle, unsigned seed) {
-    const double l = 0.30, w = 0.20, h = 0.15, step = 0.002;
-    const Eigen::Vector2d centre(0.03, -0.02);
-    std::mt19937 rng(seed);
-    std::normal_distribution<double> noise(0.0, 0.0005);
-    const Se2 box_to_table =
-        Se2::RotationAbout(angle, kTrueCentre).Compose(Se2{centre.x(), centre.y(), kBoxYaw});
-    Points pts;
-    auto side = [&](double u, double v, double z, int f) {
-        if (!Visible(f, angle)) return;
-        const Eigen::Vector2d q =
-            box_to_table.Apply(Eigen::Vector2d(u, v)) + noise(rng) * FaceNormal(f, angle);
-        pts.emplace_back(q.x(), q.y(), z);
-    };
-    for (double z = step / 2; z < h; z += step) {
-        for (double v = -w / 2; v <= w / 2; v += step) {
-            side(l / 2, v, z, 0);
-            side(-l / 2, v, z, 2);
-        }
-        for (double u = -l / 2; u <= l / 2; u += step) {
-            side(u, w / 2, z, 1);
-            side(u, -w / 2, z, 3);
-        }
-    }
-    for (double u = -l / 2; u <= l / 2; u += step) {
-        for (double v = -w / 2; v <= w / 2; v += step) {
-            const Eigen::Vector2d p = box_to_table.Apply(Eigen::Vector2d(u, v));
-            pts.emplace_back(p.x(), p.y(), h + noise(rng));
-        }
-    }
-    return pts;
-}
+const test::BoxOnTurntable kScene{{0.004, -0.003}, {0.0, 0.4, -0.3, 0.5, -0.2, 0.3, -0.4, 0.2}};
 
 // Whether views i and j share two (adjacent, so perpendicular) side faces: then the data fix
 // all of (x, y, yaw). With one shared face a view may slide along it (the top is horizontal and
 // says nothing about the motion), which the pose graph fills in from the turntable model.
 bool SharesTwoFaces(int i, int j) {
     int shared = 0;
-    for (int f = 0; f < 4; ++f) shared += Visible(f, TrueAngle(i)) && Visible(f, TrueAngle(j));
+    for (int f = 0; f < 4; ++f)
+        shared += kScene.Visible(f, kScene.TrueAngle(i)) && kScene.Visible(f, kScene.TrueAngle(j));
     return shared >= 2;
 }
 
@@ -98,9 +44,9 @@ protected:
         views_ = new std::vector<ViewClouds>();
         angles_ = new std::vector<double>();
         for (int k = 0; k < kViews; ++k) {
-            views_->push_back(BuildRegistrationClouds(BoxView(TrueAngle(k), 100 + k),
+            views_->push_back(BuildRegistrationClouds(kScene.View(kScene.TrueAngle(k), 100 + k),
                                                       config.coarse_cloud, config.fine_cloud));
-            angles_->push_back(Commanded(k));
+            angles_->push_back(kScene.Commanded(k));
         }
     }
     static void TearDownTestSuite() {
@@ -145,7 +91,7 @@ TEST_F(RegisterViewPairsTest, EdgesMatchTheTrueRelativePoses) {
     int full = 0;
     for (const PoseEdge& e : edges) {
         EXPECT_EQ(e.loop_closure, e.to != e.from + 1) << e.from << "-" << e.to;
-        const Se2 truth = TruePose(e.from).Inverse().Compose(TruePose(e.to));
+        const Se2 truth = kScene.TruePose(e.from).Inverse().Compose(kScene.TruePose(e.to));
         const Eigen::Vector3d d = Se2Difference(e.measured, truth);
         // The model starts each pair 3.8 - 7.1 mm and up to 0.8 degrees off, moving the surfaces
         // by 2.4 - 7.1 mm RMS along their normals. Every edge must bring that surface
@@ -194,7 +140,7 @@ TEST_F(RegisterViewPairsTest, PairThatCannotAlignIsLeftOut) {
     std::vector<ViewClouds> views = *views_;
     // View 3 shows the box half a metre away: nothing lies within the 2 cm correspondence gate.
     const RegistrationConfig config;
-    Points moved = BoxView(TrueAngle(3), 103);
+    Points moved = kScene.View(kScene.TrueAngle(3), 103);
     for (Eigen::Vector3f& p : moved) p.x() += 0.5f;
     views[3] = BuildRegistrationClouds(moved, config.coarse_cloud, config.fine_cloud);
     EdgeStats stats;
@@ -214,7 +160,7 @@ TEST_F(RegisterViewPairsTest, PairSharingOnlyTheTopIsLeftOut) {
     std::vector<ViewClouds> views = *views_;
     const RegistrationConfig config;
     Points top;
-    for (const Eigen::Vector3f& p : BoxView(TrueAngle(3), 103)) {
+    for (const Eigen::Vector3f& p : kScene.View(kScene.TrueAngle(3), 103)) {
         if (p.z() > 0.1495f) top.push_back(p);
     }
     views[3] = BuildRegistrationClouds(top, config.coarse_cloud, config.fine_cloud);
