@@ -37,6 +37,23 @@ const char* StatusName(MeasurementStatus s) {
     return "failed";
 }
 
+Status CheckParcelId(const std::string& id) {
+    constexpr std::size_t kMaxLength = 64;
+    if (id.empty() || id.size() > kMaxLength) {
+        return Error{ErrorCode::kInvalidInput, "must be 1 to " + std::to_string(kMaxLength) +
+                                                   " characters (got " +
+                                                   std::to_string(id.size()) + ")"};
+    }
+    for (std::size_t i = 0; i < id.size(); ++i) {
+        const auto c = static_cast<unsigned char>(id[i]);
+        if (c < 0x20 || c > 0x7e) {
+            return Error{ErrorCode::kInvalidInput,
+                         "must be printable ASCII; character " + std::to_string(i + 1) + " is not"};
+        }
+    }
+    return OkStatus();
+}
+
 json ToJson(const MeasurementResult& m) {
     json j;
     j["id"] = m.id;
@@ -67,6 +84,7 @@ json ToJson(const MeasurementResult& m) {
     } else {
         j["obb"] = nullptr;
     }
+    j["parcel_id"] = m.parcel_id ? json(*m.parcel_id) : json(nullptr);
     j["shape"] = m.shape.empty() ? json(nullptr) : json(m.shape);
     if (m.uncertainty_m) {
         const auto& u = *m.uncertainty_m;

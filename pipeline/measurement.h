@@ -64,6 +64,7 @@ struct MeasurementResult {
     std::optional<MeasurementReason> reason;
     std::optional<MeasuredDimensions> dimensions;
     std::optional<OrientedBox> obb;
+    std::optional<std::string> parcel_id;  // as the client gave it (a scanned barcode)
     std::string shape;                                  // "cuboid" | "irregular" with dimensions
     std::optional<DimensionUncertainty> uncertainty_m;  // with dimensions
     MeasurementQuality quality;
@@ -71,6 +72,11 @@ struct MeasurementResult {
 };
 
 const char* StatusName(MeasurementStatus s);
+
+// Returns Ok when `id` can be a parcel id: 1 to 64 printable ASCII characters (a barcode's
+// text); otherwise an INVALID_INPUT error saying what is wrong, for the caller to prefix with
+// the field's name.
+Status CheckParcelId(const std::string& id);
 
 // Returns the SPEC section 5 JSON object of `m`.
 nlohmann::json ToJson(const MeasurementResult& m);

@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "daemon/cli/cli.h"
 #include "drivers/station_config.h"
@@ -19,9 +20,15 @@ struct MeasureOptions {
     std::string method = "footprint";
     std::string cloud;
     std::string calibration;
+    std::optional<std::string> parcel_id;
 };
 
 int RunMeasure(const MeasureOptions& opt) {
+    if (opt.parcel_id) {
+        if (Status s = CheckParcelId(*opt.parcel_id); !s) {
+            return Fail(Error{ErrorCode::kInvalidInput, "--parcel-id " + s.error().message});
+        }
+    }
     auto session = LoadSession(opt.session);
     if (!session) return Fail(session.error());
     if (!opt.calibration.empty()) {
@@ -42,6 +49,7 @@ int RunMeasure(const MeasureOptions& opt) {
     if (!out) return Fail(out.error());
     MeasurementResult& result = out->result;
     result.id = "offline";
+    result.parcel_id = opt.parcel_id;
     result.started_at = started_at;
     result.finished_at = UtcTimestampNow();
     result.timing_ms["capture"] = 0.0;
@@ -79,6 +87,9 @@ void AddMeasure(CLI::App& app, Runner& run) {
     sub->add_option("--calibration", opt->calibration,
                     "a calibration file (what `boxd calibrate --out` writes): replaces the "
                     "session's calibration block");
+    sub->add_option("--parcel-id", opt->parcel_id,
+                    "the parcel's id (e.g. its scanned barcode: 1 to 64 printable ASCII "
+                    "characters), kept in the result as parcel_id");
     sub->callback([&run, opt] { run = [opt] { return RunMeasure(*opt); }; });
 }
 

@@ -28,6 +28,20 @@ bool NotStored(const MeasurementResult& r) {
     return r.reason && r.reason->code == ErrorCode::kStorageError;
 }
 
+// Returns the parcel id in `value`, or answers 400 naming the field and returns nullopt.
+std::optional<std::string> ParcelIdField(const json& value, Response& res) {
+    if (!value.is_string()) {
+        SetError(res, ErrorCode::kBadRequest, "parcel_id must be a string");
+        return std::nullopt;
+    }
+    const std::string id = value.get<std::string>();
+    if (Status s = CheckParcelId(id); !s) {
+        SetError(res, ErrorCode::kBadRequest, "parcel_id " + s.error().message);
+        return std::nullopt;
+    }
+    return id;
+}
+
 }  // namespace
 
 void AddMeasurementRoutes(httplib::Server& server, const ApiContext& api) {
@@ -37,8 +51,14 @@ void AddMeasurementRoutes(httplib::Server& server, const ApiContext& api) {
                         SetError(res, ErrorCode::kBadRequest, "wait must be 0, 1, true or false");
                         return;
                     }
-                    if (!JsonObjectBody(req, res, false)) return;
-                    Result<std::string> id = api.service.Start();
+                    const std::optional<json> body = JsonObjectBody(req, res, false);
+                    if (!body) return;
+                    std::optional<std::string> parcel_id;
+                    if (body->contains("parcel_id")) {
+                        parcel_id = ParcelIdField(body->at("parcel_id"), res);
+                        if (!parcel_id) return;
+                    }
+                    Result<std::string> id = api.service.Start(std::move(parcel_id));
                     if (!id) {
                         SetError(res, id.error());
                         return;
@@ -73,7 +93,12 @@ void AddMeasurementRoutes(httplib::Server& server, const ApiContext& api) {
                     return;
                 }
             }
-            auto list = api.store.List(limit);
+            std::optional<std::string> parcel_id;
+            if (req.has_param("parcel_id")) {
+                parcel_id = ParcelIdField(json(req.get_param_value("parcel_id")), res);
+                if (!parcel_id) return;
+            }
+            auto list = api.store.List(limit, parcel_id);
             if (!list) {
                 SetError(res, list.error());
                 return;

@@ -135,7 +135,7 @@ Result<std::thread> MeasurementService::Claim(bool calibrating) {
     return std::move(worker_);
 }
 
-Result<std::string> MeasurementService::Start() {
+Result<std::string> MeasurementService::Start(std::optional<std::string> parcel_id) {
     Result<std::thread> previous = Claim(false);
     if (!previous) return previous.error();
     if (previous->joinable()) previous->join();  // it has finished; only the thread is left
@@ -158,7 +158,8 @@ Result<std::string> MeasurementService::Start() {
     {
         std::lock_guard lock(mutex_);
         current_id_ = *id;
-        worker_ = std::thread(&MeasurementService::Run, this, *id, *scratch, station_);
+        worker_ = std::thread(&MeasurementService::Run, this, *id, *scratch, station_,
+                              std::move(parcel_id));
     }
     spdlog::info("measurement {} started", *id);
     Notify();
@@ -182,7 +183,8 @@ JobOutput MeasurementService::RunStation(Station& station, const JobContext& ctx
 }
 
 void MeasurementService::Run(std::string id, std::filesystem::path scratch,
-                             std::shared_ptr<Station> station) {
+                             std::shared_ptr<Station> station,
+                             std::optional<std::string> parcel_id) {
     const auto t0 = std::chrono::steady_clock::now();
     const std::string started_at = UtcTimestampNow();
     JobContext ctx;
@@ -198,6 +200,7 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
     JobOutput out = RunStation(*station, ctx);
     MeasurementResult& r = out.result;
     r.id = id;
+    r.parcel_id = std::move(parcel_id);
     r.started_at = started_at;
     r.finished_at = UtcTimestampNow();
     r.timing_ms["total"] =

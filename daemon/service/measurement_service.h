@@ -50,9 +50,10 @@ public:
     // Brings the station's devices up; on failure the state is `error` with the device error.
     Status OpenStation();
 
-    // Starts a measurement and returns its id, or BUSY while one runs, SHUTTING_DOWN after
-    // Abort(), STORAGE_ERROR when no id can be reserved.
-    Result<std::string> Start();
+    // Starts a measurement (of the parcel `parcel_id`, when given: kept with its result) and
+    // returns its id, or BUSY while one runs, SHUTTING_DOWN after Abort(), STORAGE_ERROR when no
+    // id can be reserved.
+    Result<std::string> Start(std::optional<std::string> parcel_id = std::nullopt);
     // Returns the result of measurement `id` once it has finished (it may already have), or
     // TIMEOUT after `timeout`, SHUTTING_DOWN if the run was abandoned.
     Result<MeasurementResult> WaitFor(const std::string& id, std::chrono::milliseconds timeout);
@@ -84,7 +85,8 @@ public:
     void set_on_change(std::function<void()> on_change);
 
 private:
-    void Run(std::string id, std::filesystem::path scratch, std::shared_ptr<Station> station);
+    void Run(std::string id, std::filesystem::path scratch, std::shared_ptr<Station> station,
+             std::optional<std::string> parcel_id);
     JobOutput RunStation(Station& station, const JobContext& ctx);
     struct CalibrationJob;
     void RunCalibration(std::shared_ptr<CalibrationJob> job, std::shared_ptr<Station> station);

@@ -37,6 +37,28 @@ Status MoveInto(const fs::path& from, const fs::path& to) {
     return OkStatus();
 }
 
+// Databases written before parcel ids lack the column: it is added (NULL for their rows).
+Status AddParcelIdColumn(sqlite3* db) {
+    bool present = false;
+    {
+        SqlStatement q(db, "SELECT 1 FROM pragma_table_info('measurements')"
+                           " WHERE name = 'parcel_id';");
+        if (!q.prepared()) return SqlError(db, "cannot read the measurements table's columns");
+        present = q.Step() == SQLITE_ROW;
+    }
+    auto exec = [db](const char* sql) {
+        SqlStatement s(db, sql);
+        return s.prepared() && s.Step() == SQLITE_DONE;
+    };
+    if (!present && !exec("ALTER TABLE measurements ADD COLUMN parcel_id TEXT;")) {
+        return SqlError(db, "cannot add the parcel_id column");
+    }
+    if (!exec("CREATE INDEX IF NOT EXISTS measurements_by_parcel ON measurements (parcel_id, seq);")) {
+        return SqlError(db, "cannot index the parcel ids");
+    }
+    return OkStatus();
+}
+
 Result<std::optional<json>> ParseStored(const std::string& text, const std::string& id) {
     json j = json::parse(text, nullptr, false);
     if (j.is_discarded()) return StorageError("stored JSON of " + id + " is corrupt");
@@ -81,6 +103,10 @@ Result<std::unique_ptr<MeasurementStore>> MeasurementStore::Open(const fs::path&
                                          "INSERT OR IGNORE INTO id_counter VALUES (1, 0);",
                                      });
     if (!db) return db.error();
+    if (Status s = AddParcelIdColumn(*db); !s) {
+        sqlite3_close(*db);
+        return s.error();
+    }
     std::unique_ptr<MeasurementStore> store(new MeasurementStore(data_dir, *db, retention));
     return store;
 }
@@ -148,8 +174,8 @@ Status MeasurementStore::Save(const MeasurementResult& result, const Measurement
 
     SqlStatement insert(db_,
                         "INSERT OR REPLACE INTO measurements (seq, id, started_at, finished_at,"
-                        " status, result_json, cloud_file, session_dir)"
-                        " VALUES (?, ?, ?, ?, ?, ?, ?, ?);");
+                        " status, result_json, cloud_file, session_dir, parcel_id)"
+                        " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?);");
     if (!insert.prepared()) return SqlError(db_, "cannot prepare the insert");
     insert.Bind(1, seq);
     insert.Bind(2, id);
@@ -159,6 +185,7 @@ Status MeasurementStore::Save(const MeasurementResult& result, const Measurement
     insert.Bind(6, JsonText(ToJson(result)));
     cloud_file ? insert.Bind(7, *cloud_file) : insert.BindNull(7);
     session_dir ? insert.Bind(8, *session_dir) : insert.BindNull(8);
+    result.parcel_id ? insert.Bind(9, *result.parcel_id) : insert.BindNull(9);
     if (insert.Step() != SQLITE_DONE) return SqlError(db_, "cannot store " + id);
     return ApplyRetentionLocked();
 }
@@ -217,11 +244,17 @@ Result<std::optional<json>> MeasurementStore::Get(const std::string& id) {
     return ParseStored(q.Text(0), id);
 }
 
-Result<std::vector<json>> MeasurementStore::List(int limit) {
+Result<std::vector<json>> MeasurementStore::List(int limit,
+                                                 const std::optional<std::string>& parcel_id) {
     std::lock_guard lock(mutex_);
-    SqlStatement q(db_, "SELECT id, result_json FROM measurements ORDER BY seq DESC LIMIT ?;");
+    SqlStatement q(db_, parcel_id ? "SELECT id, result_json FROM measurements WHERE parcel_id = ?"
+                                    " ORDER BY seq DESC LIMIT ?;"
+                                  : "SELECT id, result_json FROM measurements"
+                                    " ORDER BY seq DESC LIMIT ?;");
     if (!q.prepared()) return SqlError(db_, "cannot prepare a query");
-    q.Bind(1, static_cast<long long>(limit));
+    int param = 1;
+    if (parcel_id) q.Bind(param++, *parcel_id);
+    q.Bind(param, static_cast<long long>(limit));
     std::vector<json> out;
     int rc;
     while ((rc = q.Step()) == SQLITE_ROW) {

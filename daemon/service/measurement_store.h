@@ -55,8 +55,9 @@ public:
     Result<std::optional<nlohmann::json>> Last();
     // Returns measurement `id`, or nullopt when it is not stored.
     Result<std::optional<nlohmann::json>> Get(const std::string& id);
-    // Returns up to `limit` measurements, newest first.
-    Result<std::vector<nlohmann::json>> List(int limit);
+    // Returns up to `limit` measurements, newest first; with `parcel_id`, only that parcel's.
+    Result<std::vector<nlohmann::json>> List(int limit,
+                                             const std::optional<std::string>& parcel_id = {});
     // Returns the path of the fused cloud of `id`, or nullopt when `id` or its cloud is missing.
     Result<std::optional<std::filesystem::path>> CloudPath(const std::string& id);
     // Returns the number of stored measurements.

@@ -165,6 +165,23 @@ TEST(CliMeasure, BadCalibrationFileIsBadInputNamingTheField) {
     expect_bad(WriteFile(dir, "broken.yaml", "calibration: [\n"), "broken.yaml");
 }
 
+TEST(CliMeasure, ParcelIdGoesIntoTheResultAndABadOneIsBadInput) {
+    TempDir dir;
+    const auto session = Synth(dir, "s", {"--dims", "0.3", "0.2", "0.2"});
+    const auto ok = RunBoxd({"measure", "--session", session.string(), "--parcel-id", "1Z999AA1"});
+    ASSERT_EQ(ok.exit_code, 0) << ok.err;
+    EXPECT_EQ(nlohmann::json::parse(ok.out)["parcel_id"], "1Z999AA1");
+    const auto plain = RunBoxd({"measure", "--session", session.string()});
+    EXPECT_TRUE(nlohmann::json::parse(plain.out)["parcel_id"].is_null());
+    for (const std::string& bad :
+         std::vector<std::string>{std::string(), std::string(65, 'x'), std::string("a\nb")}) {
+        const auto r = RunBoxd({"measure", "--session", session.string(), "--parcel-id", bad});
+        EXPECT_EQ(r.exit_code, 2) << r.out;
+        EXPECT_TRUE(r.out.empty());
+        EXPECT_NE(r.err.find("--parcel-id"), std::string::npos) << r.err;
+    }
+}
+
 TEST(CliMeasure, OversizedFramesAndTooManyFramesAreBadInputNotACrash) {
     TempDir dir;
     const auto session = Synth(dir, "s", {"--dims", "0.3", "0.2", "0.2"});

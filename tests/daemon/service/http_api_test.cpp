@@ -204,6 +204,59 @@ TEST_F(HttpApiTest, BadRequestsGetTheirCodesAndTheDaemonKeepsServing) {
     EXPECT_EQ(ok->status, 200);
 }
 
+TEST_F(HttpApiTest, ParcelIdIsKeptWithTheMeasurementAndFindsIt) {
+    auto with = client_->Post("/v1/measure?wait=1", R"({"parcel_id": "PKG 0042/a"})",
+                              "application/json");
+    ASSERT_TRUE(with);
+    ASSERT_EQ(with->status, 200) << with->body;
+    const json first = Body(with);
+    EXPECT_EQ(first["parcel_id"], "PKG 0042/a");
+    auto without = client_->Post("/v1/measure?wait=1", "", "application/json");
+    ASSERT_TRUE(without);
+    ASSERT_EQ(without->status, 200) << without->body;
+    EXPECT_TRUE(Body(without)["parcel_id"].is_null());
+    auto again = client_->Post("/v1/measure?wait=1", R"({"parcel_id": "PKG 0042/a"})",
+                               "application/json");
+    ASSERT_TRUE(again);
+    ASSERT_EQ(again->status, 200) << again->body;
+
+    // Newest first, that parcel's only; the query's value is URL-decoded like any other.
+    auto found = client_->Get("/v1/measurements?parcel_id=PKG%200042%2Fa");
+    ASSERT_TRUE(found);
+    ASSERT_EQ(found->status, 200) << found->body;
+    const json list = Body(found)["measurements"];
+    ASSERT_EQ(list.size(), 2u) << list.dump();
+    EXPECT_EQ(list[0], Body(again));
+    EXPECT_EQ(list[1], first);
+    auto one = client_->Get("/v1/measurements?parcel_id=PKG%200042%2Fa&limit=1");
+    ASSERT_TRUE(one);
+    EXPECT_EQ(Body(one)["measurements"].size(), 1u);
+    auto none = client_->Get("/v1/measurements?parcel_id=PKG-9999");
+    ASSERT_TRUE(none);
+    EXPECT_EQ(none->status, 200);
+    EXPECT_TRUE(Body(none)["measurements"].empty());
+}
+
+TEST_F(HttpApiTest, BadParcelIdsAre400NamingTheFieldAndStartNothing) {
+    for (const std::string& body : std::vector<std::string>{
+             R"({"parcel_id": ""})", R"({"parcel_id": 42})", R"({"parcel_id": null})",
+          R"({"parcel_id": "tab\there"})", R"({"parcel_id": "caf\u00e9"})",
+          R"({"parcel_id": ")" + std::string(65, 'x') + R"("})"}) {
+        auto res = client_->Post("/v1/measure?wait=1", body, "application/json");
+        ExpectError(res, 400, "BAD_REQUEST");
+        EXPECT_NE(res->body.find("parcel_id"), std::string::npos) << res->body;
+    }
+    ExpectError(client_->Get("/v1/measurements?parcel_id="), 400, "BAD_REQUEST");
+    auto list = client_->Get("/v1/measurements");
+    ASSERT_TRUE(list);
+    EXPECT_TRUE(Body(list)["measurements"].empty()) << list->body;
+    auto longest = client_->Post("/v1/measure?wait=1",
+                                 R"({"parcel_id": ")" + std::string(64, '~') + R"("})",
+                                 "application/json");
+    ASSERT_TRUE(longest);
+    EXPECT_EQ(longest->status, 200) << longest->body;
+}
+
 TEST_F(HttpApiTest, CalibrateRunsTheStationCalibrationAndReportsRefusals) {
     auto done =
         client_->Post("/v1/calibrate", R"({"reference_m": [0.4, 0.3, 0.2]})", "application/json");

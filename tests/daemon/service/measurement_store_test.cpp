@@ -1,6 +1,7 @@
 #include "daemon/service/measurement_store.h"
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include <fstream>
 
@@ -116,6 +117,49 @@ TEST(MeasurementStore, ListsNewestFirstWithLimit) {
     auto none = (*store)->CloudPath("m-000004");
     ASSERT_TRUE(none);
     EXPECT_FALSE(none->has_value());  // stored without a cloud
+}
+
+TEST(MeasurementStore, ADatabaseFromBeforeParcelIdsGainsTheColumnAndKeepsItsRows) {
+    test::TempDir dir;
+    {
+        // The schema as boxd wrote it before parcel ids, with one measurement in it.
+        sqlite3* db = nullptr;
+        ASSERT_EQ(sqlite3_open((dir / "boxd.db").c_str(), &db), SQLITE_OK);
+        const char* old =
+            "CREATE TABLE measurements (seq INTEGER PRIMARY KEY, id TEXT NOT NULL UNIQUE,"
+            " started_at TEXT NOT NULL, finished_at TEXT NOT NULL, status TEXT NOT NULL,"
+            " result_json TEXT NOT NULL, cloud_file TEXT, session_dir TEXT);"
+            "CREATE TABLE id_counter (one INTEGER PRIMARY KEY CHECK (one = 1),"
+            " last_seq INTEGER NOT NULL);"
+            "INSERT INTO id_counter VALUES (1, 1);"
+            "INSERT INTO measurements VALUES (1, 'm-000001', 'a', 'b', 'ok', '{\"id\":"
+            " \"m-000001\"}', NULL, NULL);";
+        ASSERT_EQ(sqlite3_exec(db, old, nullptr, nullptr, nullptr), SQLITE_OK);
+        sqlite3_close(db);
+    }
+    auto store = MeasurementStore::Open(dir.path(), 10);
+    ASSERT_TRUE(store) << store.error().message;
+    auto next = (*store)->ReserveId();
+    ASSERT_TRUE(next);
+    EXPECT_EQ(*next, "m-000002");
+    MeasurementResult r = ResultOf(*next);
+    r.parcel_id = "PKG-1";
+    ASSERT_TRUE((*store)->Save(r, {}));
+    auto all = (*store)->List(10);
+    ASSERT_TRUE(all);
+    ASSERT_EQ(all->size(), 2u);
+    EXPECT_EQ((*all)[1]["id"], "m-000001");
+    auto parcel = (*store)->List(10, std::string("PKG-1"));
+    ASSERT_TRUE(parcel);
+    ASSERT_EQ(parcel->size(), 1u);
+    EXPECT_EQ((*parcel)[0]["parcel_id"], "PKG-1");
+    store->reset();
+    // Opening again finds the column there and leaves it.
+    auto reopened = MeasurementStore::Open(dir.path(), 10);
+    ASSERT_TRUE(reopened) << reopened.error().message;
+    auto again = (*reopened)->List(10, std::string("PKG-1"));
+    ASSERT_TRUE(again);
+    EXPECT_EQ(again->size(), 1u);
 }
 
 TEST(MeasurementStore, RetentionDeletesOldRowsAndTheirFiles) {

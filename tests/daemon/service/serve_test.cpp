@@ -119,11 +119,13 @@ TEST(ServeSimStation, MeasuresTheSimulatedBoxAndServesItAcrossKill9) {
         ASSERT_TRUE(none);
         EXPECT_EQ(none->status, 404);
 
-        auto res = client.Post("/v1/measure?wait=1", "", "application/json");
+        auto res = client.Post("/v1/measure?wait=1", R"({"parcel_id": "PKG-0042"})",
+                               "application/json");
         ASSERT_TRUE(res) << httplib::to_string(res.error());
         ASSERT_EQ(res->status, 200) << res->body;
         first = json::parse(res->body);
         EXPECT_EQ(first["id"], "m-000001");
+        EXPECT_EQ(first["parcel_id"], "PKG-0042");
         ASSERT_EQ(first["status"], "ok") << first.dump(2) << ReadText(dir / "serve1.log");
         const json& d = first["dimensions"];
         EXPECT_NEAR(d["length_m"].get<double>(), true_l, 0.015) << first.dump(2);
@@ -141,6 +143,8 @@ TEST(ServeSimStation, MeasuresTheSimulatedBoxAndServesItAcrossKill9) {
         EXPECT_GE(early, 1) << log.substr(of - 20, 80);
 
         EXPECT_EQ(daemon.GetJson("/v1/measurements/last"), first);
+        EXPECT_EQ(daemon.GetJson("/v1/measurements?parcel_id=PKG-0042")["measurements"],
+                  json::array({first}));
         EXPECT_EQ(daemon.GetJson("/v1/measurements/m-000001"), first);
         auto cloud = client.Get("/v1/measurements/m-000001/cloud.ply");
         ASSERT_TRUE(cloud);
