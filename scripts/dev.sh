@@ -40,10 +40,23 @@ deps() {
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y --no-install-recommends "${PACKAGES[@]}"
 }
 
+# Configures `dir` with the given options unless it already is: configuring a configured tree
+# again reorders PCL's include directories, which rebuilds everything. (cmake --build still
+# reconfigures by itself when a CMakeLists.txt changes.)
+configure() {
+    local dir=$1 stamp=$2
+    shift 2
+    if [ -f "$dir/CMakeCache.txt" ] && [ "$(cat "$dir/.dev-configured" 2>/dev/null)" = "$stamp" ]; then
+        return
+    fi
+    cmake -S . -B "$dir" "$@"
+    echo "$stamp" > "$dir/.dev-configured"
+}
+
 build() {
     local werror=OFF
     [ "${CI:-}" = "true" ] && werror=ON
-    cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DBOXD_WERROR="$werror"
+    configure "$BUILD_DIR" "werror=$werror" -DCMAKE_BUILD_TYPE=Release -DBOXD_WERROR="$werror"
     # Targets as arguments (the demo needs only boxd); none builds everything, tests included.
     local targets=()
     for t in "$@"; do targets+=(--target "$t"); done
@@ -83,7 +96,7 @@ export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/tests/fuzz/lsan.supp:print_suppressions=0}
 
 sanitize_build() {
-    CC=clang CXX=clang++ cmake -S . -B "$SAN_DIR" -DCMAKE_BUILD_TYPE=Release \
+    CC=clang CXX=clang++ configure "$SAN_DIR" sanitize -DCMAKE_BUILD_TYPE=Release \
         -DBOXD_SANITIZE=ON -DBOXD_FUZZ=ON
     local targets=()
     for t in "$@"; do targets+=(--target "$t"); done
