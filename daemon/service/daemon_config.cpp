@@ -20,7 +20,9 @@ Status CheckKeys(const YAML::Node& node, const std::string& section,
     if (!node.IsMap()) return ConfigError(section, "expected a mapping");
     std::set<std::string> seen;
     for (const auto& kv : node) {
-        const std::string key = kv.first.as<std::string>();
+        // A key that is a list or a map (`{[a]: 1}`) has no name to check or report.
+        if (!kv.first.IsScalar()) return ConfigError(section, "every key must be a plain name");
+        const std::string key = kv.first.Scalar();
         if (!known.count(key)) return ConfigError(section + "." + key, "unknown key");
         // YAML keeps both of two equal keys; which one counts would be a guess.
         if (!seen.insert(key).second) return ConfigError(section + "." + key, "given twice");

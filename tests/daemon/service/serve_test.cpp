@@ -97,6 +97,15 @@ TEST(ServeConfig, BadValuesNameTheKeyAndExitWith2) {
                                 (dir / "data").string()});
     EXPECT_EQ(twice.exit_code, 2);
     EXPECT_NE(twice.err.find("server.max_body_bytes"), std::string::npos) << twice.err;
+    // A key that is itself a list (found by tests/fuzz/config_fuzz.cpp: the daemon aborted on
+    // an uncaught exception instead of naming the section).
+    text.insert(text.find(server) + server.size(), "  [listen]: 1\n");
+    std::ofstream(dir / "listkey.yaml") << text;
+    auto listkey = test::RunBoxd({"serve", "--config", (dir / "listkey.yaml").string(),
+                                  "--data-dir", (dir / "data").string()});
+    EXPECT_EQ(listkey.exit_code, 2) << listkey.err;
+    EXPECT_NE(listkey.err.find("server: every key must be a plain name"), std::string::npos)
+        << listkey.err;
 }
 
 // The whole chain on config/sim.yaml: measure, read back, cloud, bad requests and a refused
