@@ -17,7 +17,7 @@ PACKAGES=(
     libmodbus-dev libopenni2-dev libusb-1.0-0-dev
     libyaml-cpp-dev nlohmann-json3-dev libcpp-httplib-dev libcli11-dev libspdlog-dev
     libsqlite3-dev libsystemd-dev libgtest-dev libembree-dev libpng-dev
-    socat curl clang libclang-rt-14-dev
+    socat curl clang libclang-rt-14-dev python3-jsonschema
 )
 BUILD_DIR=${BUILD_DIR:-build}
 JOBS=${JOBS:-$(nproc)}

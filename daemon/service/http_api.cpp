@@ -14,6 +14,7 @@
 #include "daemon/service/connection_pool.h"
 #include "daemon/service/http_response.h"
 #include "daemon/service/http_routes.h"
+#include "daemon/service/openapi_document.h"
 #include "daemon/service/service_json.h"
 
 namespace boxd {
@@ -25,6 +26,12 @@ using Response = httplib::Response;
 namespace {
 
 const auto kProcessStart = std::chrono::steady_clock::now();
+
+long long UptimeSeconds() {
+    return std::chrono::duration_cast<std::chrono::seconds>(std::chrono::steady_clock::now() -
+                                                            kProcessStart)
+        .count();
+}
 
 // Compares in time independent of where the strings differ, so the token cannot be guessed
 // byte by byte from response times.
@@ -79,12 +86,29 @@ void AddStatusRoutes(httplib::Server& server, const ApiContext& api) {
     server.Get("/v1/status", Guarded([api](const Request&, Response& res) {
                    const ServiceSnapshot snapshot = api.service.Snapshot();
                    const std::shared_ptr<Station> station = api.service.station();
-                   const long long uptime_s = std::chrono::duration_cast<std::chrono::seconds>(
-                                                  std::chrono::steady_clock::now() - kProcessStart)
-                                                  .count();
+                   const long long uptime_s = UptimeSeconds();
                    SetJson(
                        res, 200,
                        StatusJson(snapshot, station->Devices(), station->Calibration(), uptime_s));
+               }));
+
+    server.Get("/v1/openapi.json", Guarded([](const Request&, Response& res) {
+                   res.status = 200;
+                   res.set_content(OpenApiDocument(), "application/json");
+               }));
+
+    // The Prometheus exposition (service_metrics.h); GETs need the token only with protect_reads.
+    server.Get("/metrics", Guarded([api](const Request&, Response& res) {
+                   const std::shared_ptr<Station> station = api.service.station();
+                   const CalibrationInForce calibration = station->Calibration();
+                   MetricsContext context;
+                   context.state = ServiceStateName(api.service.Snapshot().state);
+                   context.calibrated = calibration.calibration.has_value();
+                   if (context.calibrated) context.calibration_age_s = calibration.age_s;
+                   context.uptime_s = UptimeSeconds();
+                   res.status = 200;
+                   res.set_content(api.service.metrics().Text(context),
+                                   "text/plain; version=0.0.4; charset=utf-8");
                }));
 }
 

@@ -22,7 +22,7 @@ struct ApiContext {
     const std::function<bool()>& loop_alive;  // GET /v1/health: the service loop still runs
 };
 
-// GET /v1/health, GET /v1/status.
+// GET /v1/health, GET /v1/status, GET /v1/openapi.json, GET /metrics.
 void AddStatusRoutes(httplib::Server& server, const ApiContext& api);
 // POST /v1/measure, GET /v1/measurements, /v1/measurements/{id} (and "last"),
 // /v1/measurements/{id}/cloud.ply.

@@ -98,6 +98,7 @@ Status MeasurementService::OpenStation() {
             last_error_at_ = UtcTimestampNow();
         }
     }
+    if (!s) metrics_.RecordFault(s.error().code);
     Notify();
     return s;
 }
@@ -228,6 +229,7 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
                                      "the result could not be stored: " + saved.error().message};
     }
     LogMeasurement(r);
+    metrics_.RecordMeasurement(r);
     const bool station_ok = station->IsOpen();
     {
         std::lock_guard lock(mutex_);
@@ -323,6 +325,7 @@ void MeasurementService::RunCalibration(std::shared_ptr<CalibrationJob> job,
                       result.error().message);
     }
     RecordCalibration(job->reference, result);
+    if (!result) metrics_.RecordFault(result.error().code);
     const bool station_ok = station->IsOpen();
     {
         std::lock_guard lock(mutex_);

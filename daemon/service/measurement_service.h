@@ -18,6 +18,7 @@
 
 #include "daemon/service/calibration_history.h"
 #include "daemon/service/measurement_store.h"
+#include "daemon/service/service_metrics.h"
 #include "daemon/service/station.h"
 #include "pipeline/result.h"
 
@@ -75,6 +76,8 @@ public:
 
     bool Busy() const;
     ServiceSnapshot Snapshot() const;
+    // The counters of GET /metrics: every finished measurement and every device fault.
+    const ServiceMetrics& metrics() const { return metrics_; }
     std::shared_ptr<Station> station() const;
 
     // Puts a new station (and the keep-sessions setting) in force; BUSY while a run uses the
@@ -120,7 +123,8 @@ private:
     int finished_ = 0;
     std::thread worker_;
     std::function<void()> on_change_;
-    std::unique_ptr<CalibrationHistory> history_;  // null when it could not be opened
+    std::unique_ptr<CalibrationHistory> history_;
+    ServiceMetrics metrics_;  // null when it could not be opened
 };
 
 }  // namespace boxd

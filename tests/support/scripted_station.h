@@ -19,6 +19,7 @@ public:
     std::atomic<bool> in_capture{false};
     std::atomic<int> stop_requests{0};
     std::atomic<bool> fail_next{false};
+    std::atomic<bool> refuse_next{false};  // the next measurement is no_dim MULTIPLE_OBJECTS
 
     Status Open() override {
         open_ = true;
@@ -40,10 +41,16 @@ public:
             out.result.reason = MeasurementReason{ErrorCode::kTurntableError, "sim: stall"};
             return out;
         }
+        out.result.timing_ms["capture"] = 12.0;
+        out.result.timing_ms["processing"] = 80.0;
+        if (refuse_next.exchange(false)) {
+            out.result.status = MeasurementStatus::kNoDim;
+            out.result.reason = MeasurementReason{ErrorCode::kMultipleObjects, "two objects"};
+            return out;
+        }
         out.result.status = MeasurementStatus::kOk;
         out.result.dimensions = MeasuredDimensions{0.4, 0.3, 0.2, 0.024, "footprint"};
         out.result.quality.poses = 4;
-        out.result.timing_ms["capture"] = 12.0;
         const auto ply = ctx.scratch_dir / "cloud.ply";
         std::ofstream(ply) << "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n";
         out.files.cloud_ply = ply;

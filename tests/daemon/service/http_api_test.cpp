@@ -16,6 +16,7 @@
 
 #include "daemon/service/measurement_service.h"
 #include "daemon/service/measurement_store.h"
+#include "tests/support/prometheus_text.h"
 #include "tests/support/scripted_station.h"
 #include "tests/support/temp_dir.h"
 
@@ -314,6 +315,38 @@ TEST_F(HttpApiTest, DeviceFailureIsStoredAndShownAsErrorState) {
     EXPECT_EQ(Body(client_->Get("/v1/status"))["state"], "idle");
 }
 
+TEST_F(HttpApiTest, MetricsCountWhatFinishedByStatusReasonAndFault) {
+    auto before = client_->Get("/metrics");
+    ASSERT_TRUE(before);
+    ASSERT_EQ(before->status, 200);
+    EXPECT_EQ(before->get_header_value("Content-Type").rfind("text/plain; version=0.0.4", 0), 0u);
+    EXPECT_EQ(test::ParsePrometheus(before->body).at("boxd_measurements_total{status=\"ok\"}"), 0);
+
+    ASSERT_EQ(Body(client_->Post("/v1/measure?wait=1", "", "application/json"))["status"], "ok");
+    station_->refuse_next = true;
+    ASSERT_EQ(Body(client_->Post("/v1/measure?wait=1", "", "application/json"))["status"],
+              "no_dim");
+    station_->fail_next = true;
+    ASSERT_EQ(Body(client_->Post("/v1/measure?wait=1", "", "application/json"))["status"],
+              "failed");
+
+    auto after = client_->Get("/metrics");
+    ASSERT_TRUE(after);
+    const auto s = test::ParsePrometheus(after->body);
+    EXPECT_EQ(s.at("boxd_measurements_total{status=\"ok\"}"), 1);
+    EXPECT_EQ(s.at("boxd_measurements_total{status=\"no_dim\"}"), 1);
+    EXPECT_EQ(s.at("boxd_measurements_total{status=\"failed\"}"), 1);
+    EXPECT_EQ(
+        s.at("boxd_measurement_reasons_total{status=\"no_dim\",code=\"MULTIPLE_OBJECTS\"}"), 1);
+    EXPECT_EQ(s.at("boxd_device_faults_total{device=\"turntable\"}"), 1);
+    EXPECT_EQ(s.at("boxd_measurement_cycle_seconds_count"), 3);
+    // The failed run stopped before processing: two processing times, both 80 ms.
+    EXPECT_EQ(s.at("boxd_measurement_processing_seconds_bucket{le=\"0.1\"}"), 2);
+    EXPECT_EQ(s.at("boxd_state{state=\"error\"}"), 1);  // the turntable fault is the last word
+    EXPECT_EQ(s.at("boxd_calibrated"), 1);
+    EXPECT_EQ(s.at("boxd_calibration_age_seconds"), 42);
+}
+
 TEST_F(HttpApiTest, AbortStopsTheTableAndRecordsTheAbortedMeasurement) {
     station_->hold = true;
     auto first = client_->Post("/v1/measure", "", "application/json");
@@ -486,6 +519,7 @@ protected:
 TEST_F(HttpApiProtectedReadsTest, GetsNeedTheTokenToo) {
     ExpectError(client_->Get("/v1/status"), 401, "UNAUTHORIZED");
     ExpectError(client_->Get("/v1/measurements/last"), 401, "UNAUTHORIZED");
+    ExpectError(client_->Get("/metrics"), 401, "UNAUTHORIZED");
     auto ok = client_->Get("/v1/status", {{"Authorization", "Bearer s3cret"}});
     ASSERT_TRUE(ok);
     EXPECT_EQ(ok->status, 200);

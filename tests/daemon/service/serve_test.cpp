@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "tests/support/run_command.h"
+#include "tests/support/prometheus_text.h"
 #include "tests/support/serve_daemon.h"
 #include "tests/support/temp_dir.h"
 
@@ -155,6 +156,15 @@ TEST(ServeSimStation, MeasuresTheSimulatedBoxAndServesItAcrossKill9) {
         EXPECT_EQ(daemon.GetJson("/v1/measurements?parcel_id=PKG-0042")["measurements"],
                   json::array({first}));
         EXPECT_EQ(daemon.GetJson("/v1/measurements/m-000001"), first);
+        auto metrics = client.Get("/metrics");
+        ASSERT_TRUE(metrics);
+        ASSERT_EQ(metrics->status, 200);
+        const auto samples = test::ParsePrometheus(metrics->body);
+        EXPECT_EQ(samples.at("boxd_measurements_total{status=\"ok\"}"), 1) << metrics->body;
+        EXPECT_EQ(samples.at("boxd_measurement_cycle_seconds_count"), 1);
+        EXPECT_NEAR(samples.at("boxd_measurement_cycle_seconds_sum"),
+                    first["timing_ms"]["total"].get<double>() / 1e3, 1e-3);
+        EXPECT_EQ(samples.at("boxd_calibrated"), 1);
         auto cloud = client.Get("/v1/measurements/m-000001/cloud.ply");
         ASSERT_TRUE(cloud);
         EXPECT_EQ(cloud->status, 200);

@@ -1,0 +1,130 @@
+#include "daemon/service/service_metrics.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string_view>
+
+#ifndef BOXD_VERSION
+#define BOXD_VERSION "unknown"
+#endif
+
+namespace boxd {
+
+namespace {
+
+// Returns `v` as a Prometheus sample value: the shortest of 15 or 17 digits that reads back
+// as `v` (0.1 rather than 0.10000000000000001), integers without a fraction.
+std::string Number(double v) {
+    char buf[40];
+    std::snprintf(buf, sizeof buf, "%.15g", v);
+    if (std::strtod(buf, nullptr) != v) std::snprintf(buf, sizeof buf, "%.17g", v);
+    return buf;
+}
+
+// Appends the HELP and TYPE lines of metric `name`.
+void Header(std::string& out, std::string_view name, std::string_view type, std::string_view help) {
+    out.append("# HELP ").append(name).append(" ").append(help).append("\n");
+    out.append("# TYPE ").append(name).append(" ").append(type).append("\n");
+}
+
+// Appends one sample `name{labels} value` (labels already formatted, or empty).
+void Sample(std::string& out, std::string_view name, const std::string& labels, double value) {
+    out.append(name);
+    if (!labels.empty()) out.append("{").append(labels).append("}");
+    out.append(" ").append(Number(value)).append("\n");
+}
+
+void AppendHistogram(std::string& out, std::string_view name, std::string_view help,
+                     const Histogram& h) {
+    Header(out, name, "histogram", help);
+    const std::string bucket = std::string(name) + "_bucket";
+    for (std::size_t i = 0; i < Histogram::kBounds.size(); ++i) {
+        Sample(out, bucket, "le=\"" + Number(Histogram::kBounds[i]) + "\"",
+               static_cast<double>(h.buckets[i]));
+    }
+    Sample(out, bucket, "le=\"+Inf\"", static_cast<double>(h.count));
+    Sample(out, std::string(name) + "_sum", "", h.sum);
+    Sample(out, std::string(name) + "_count", "", static_cast<double>(h.count));
+}
+
+}  // namespace
+
+void Histogram::Observe(double seconds) {
+    if (!std::isfinite(seconds) || seconds < 0.0) return;
+    for (std::size_t i = 0; i < kBounds.size(); ++i) {
+        if (seconds <= kBounds[i]) ++buckets[i];
+    }
+    ++count;
+    sum += seconds;
+}
+
+void ServiceMetrics::RecordMeasurement(const MeasurementResult& r) {
+    std::lock_guard lock(mutex_);
+    const std::string status = StatusName(r.status);
+    ++by_status_[status];
+    if (r.reason) ++by_reason_[{status, ErrorCodeName(r.reason->code)}];
+    if (auto t = r.timing_ms.find("total"); t != r.timing_ms.end()) cycle_.Observe(t->second / 1e3);
+    if (auto t = r.timing_ms.find("processing"); t != r.timing_ms.end()) {
+        processing_.Observe(t->second / 1e3);
+    }
+    if (r.reason && r.reason->code == ErrorCode::kTurntableError) ++turntable_faults_;
+    if (r.reason && r.reason->code == ErrorCode::kCameraError) ++camera_faults_;
+}
+
+void ServiceMetrics::RecordFault(ErrorCode code) {
+    std::lock_guard lock(mutex_);
+    if (code == ErrorCode::kTurntableError) ++turntable_faults_;
+    if (code == ErrorCode::kCameraError) ++camera_faults_;
+}
+
+std::string ServiceMetrics::Text(const MetricsContext& context) const {
+    std::lock_guard lock(mutex_);
+    std::string out;
+    Header(out, "boxd_build_info", "gauge", "The running boxd's version (always 1).");
+    Sample(out, "boxd_build_info", "version=\"" BOXD_VERSION "\"", 1);
+    Header(out, "boxd_uptime_seconds", "gauge", "Seconds since the daemon started.");
+    Sample(out, "boxd_uptime_seconds", "", static_cast<double>(context.uptime_s));
+    Header(out, "boxd_state", "gauge", "The service state: 1 for the current one.");
+    for (const char* s : {"starting", "idle", "measuring", "calibrating", "error"}) {
+        Sample(out, "boxd_state", std::string("state=\"") + s + "\"",
+               std::string_view(s) == context.state ? 1 : 0);
+    }
+
+    Header(out, "boxd_measurements_total", "counter", "Finished measurements by status.");
+    for (const char* s : {"ok", "no_dim", "failed"}) {
+        const auto it = by_status_.find(s);
+        Sample(out, "boxd_measurements_total", std::string("status=\"") + s + "\"",
+               static_cast<double>(it == by_status_.end() ? 0 : it->second));
+    }
+    Header(out, "boxd_measurement_reasons_total", "counter",
+           "Measurements without dimensions by status and reason code.");
+    for (const auto& [key, n] : by_reason_) {
+        Sample(out, "boxd_measurement_reasons_total",
+               "status=\"" + key.first + "\",code=\"" + key.second + "\"",
+               static_cast<double>(n));
+    }
+    AppendHistogram(out, "boxd_measurement_cycle_seconds",
+                    "A measurement's whole time: capture, processing and storing.", cycle_);
+    AppendHistogram(out, "boxd_measurement_processing_seconds",
+                    "A measurement's processing after the last frame.", processing_);
+
+    Header(out, "boxd_device_faults_total", "counter",
+           "Turntable and camera faults (in measurements, calibrations and opening the devices).");
+    Sample(out, "boxd_device_faults_total", "device=\"turntable\"",
+           static_cast<double>(turntable_faults_));
+    Sample(out, "boxd_device_faults_total", "device=\"camera\"",
+           static_cast<double>(camera_faults_));
+
+    Header(out, "boxd_calibrated", "gauge", "1 when a station calibration is in force.");
+    Sample(out, "boxd_calibrated", "", context.calibrated ? 1 : 0);
+    if (context.calibration_age_s) {
+        Header(out, "boxd_calibration_age_seconds", "gauge",
+               "Age of the calibration in force (its file's modification time).");
+        Sample(out, "boxd_calibration_age_seconds", "",
+               static_cast<double>(*context.calibration_age_s));
+    }
+    return out;
+}
+
+}  // namespace boxd
