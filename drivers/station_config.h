@@ -50,8 +50,8 @@ Result<StationCalibration> ParseCalibration(const YAML::Node& node);
 Result<StationCalibration> LoadCalibrationFile(const std::filesystem::path& path);
 
 // Top-level sections that belong to other parts of boxd (the daemon's) and are skipped here.
-inline const std::vector<std::string> kOtherConfigSections = {"server", "storage", "pipeline",
-                                                              "measurement", "logging"};
+inline const std::vector<std::string> kOtherConfigSections = {
+    "server", "storage", "mqtt", "pipeline", "measurement", "logging"};
 
 struct StationConfig {
     TurntableConfig turntable;

@@ -3,6 +3,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <set>
 
@@ -112,6 +113,34 @@ Status StorageConfig::Validate() const {
     return OkStatus();
 }
 
+Status MqttConfig::Validate() const {
+    if (!enabled) return OkStatus();
+    if (host.empty()) return ConfigError("mqtt.host", "must be given");
+    if (port < 0 || port > 65535) return ConfigError("mqtt.port", "must be in 0..65535");
+    if (station_id.empty() || station_id.size() > 64 ||
+        !std::all_of(station_id.begin(), station_id.end(), [](char c) {
+            return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' ||
+                   c == '-';
+        })) {
+        return ConfigError("mqtt.station_id",
+                           "must be 1 to 64 letters, digits, '.', '_' or '-' (it names topics)");
+    }
+    if (!password.empty() && username.empty()) {
+        return ConfigError("mqtt.password", "needs mqtt.username");
+    }
+    if (!tls_ca_file.empty() && !tls) return ConfigError("mqtt.tls_ca_file", "needs mqtt.tls");
+    if (keepalive_s < 5 || keepalive_s > 3600) {
+        return ConfigError("mqtt.keepalive_s", "must be in 5..3600");
+    }
+    if (queue_limit < 1 || queue_limit > 100000) {
+        return ConfigError("mqtt.queue_limit", "must be in 1..100000");
+    }
+    if (reconnect_max_s < 1 || reconnect_max_s > 3600) {
+        return ConfigError("mqtt.reconnect_max_s", "must be in 1..3600");
+    }
+    return OkStatus();
+}
+
 Result<ServerConfig> ParseServerConfig(const YAML::Node& node) {
     ServerConfig c;
     if (!node || node.IsNull()) return c;
@@ -150,6 +179,32 @@ Result<StorageConfig> ParseStorageConfig(const YAML::Node& node) {
     for (Status s : {ReadKey(node, "storage", "data_dir", c.data_dir),
                      ReadKey(node, "storage", "retention", c.retention),
                      ReadKey(node, "storage", "keep_sessions", c.keep_sessions)}) {
+        if (!s) return s.error();
+    }
+    if (auto s = c.Validate(); !s) return s.error();
+    return c;
+}
+
+Result<MqttConfig> ParseMqttConfig(const YAML::Node& node) {
+    MqttConfig c;
+    if (!node || node.IsNull()) return c;
+    if (auto s = CheckKeys(node, "mqtt",
+                           {"host", "port", "station_id", "username", "password", "tls",
+                            "tls_ca_file", "keepalive_s", "queue_limit", "reconnect_max_s"});
+        !s) {
+        return s.error();
+    }
+    c.enabled = true;
+    for (Status s : {ReadKey(node, "mqtt", "host", c.host),
+                     ReadKey(node, "mqtt", "port", c.port),
+                     ReadKey(node, "mqtt", "station_id", c.station_id),
+                     ReadKey(node, "mqtt", "username", c.username),
+                     ReadKey(node, "mqtt", "password", c.password),
+                     ReadKey(node, "mqtt", "tls", c.tls),
+                     ReadKey(node, "mqtt", "tls_ca_file", c.tls_ca_file),
+                     ReadKey(node, "mqtt", "keepalive_s", c.keepalive_s),
+                     ReadKey(node, "mqtt", "queue_limit", c.queue_limit),
+                     ReadKey(node, "mqtt", "reconnect_max_s", c.reconnect_max_s)}) {
         if (!s) return s.error();
     }
     if (auto s = c.Validate(); !s) return s.error();

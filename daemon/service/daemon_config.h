@@ -51,10 +51,34 @@ struct StorageConfig {
     Status Validate() const;
 };
 
+// The `mqtt:` section: publish every finished measurement and the state to a broker (a fleet's
+// message bus). Absent: nothing is published.
+struct MqttConfig {
+    bool enabled = false;     // the section is present
+    std::string host;         // the broker
+    int port = 0;             // 0: 1883, or 8883 with tls
+    std::string station_id;   // topics boxd/<station_id>/...: letters, digits, '.', '_', '-'
+    std::string username;     // optional
+    std::string password;     // optional, needs username
+    bool tls = false;         // TLS to the broker, checked against the system's CAs ...
+    std::string tls_ca_file;  // ... or this CA file
+    int keepalive_s = 30;     // the broker declares the station offline after 1.5 times this
+    int queue_limit = 1000;   // measurements kept while the broker is away (then the oldest go)
+    int reconnect_max_s = 60;  // reconnect backoff: 1 s, doubling up to this
+
+    // Returns an error naming the first invalid field ("mqtt.<field>: ..."), or Ok.
+    Status Validate() const;
+    // Returns the port to connect to (the default for plain or TLS when port is 0).
+    int EffectivePort() const { return port != 0 ? port : (tls ? 8883 : 1883); }
+    bool operator==(const MqttConfig&) const = default;
+};
+
 // Returns the config read from a `server:` YAML node (missing keys keep their defaults;
 // unknown keys, wrong types and invalid values are errors naming the key).
 Result<ServerConfig> ParseServerConfig(const YAML::Node& node);
 // Same for the `storage:` section.
 Result<StorageConfig> ParseStorageConfig(const YAML::Node& node);
+// Same for the `mqtt:` section (absent or null: not enabled).
+Result<MqttConfig> ParseMqttConfig(const YAML::Node& node);
 
 }  // namespace boxd

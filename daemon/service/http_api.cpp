@@ -106,6 +106,7 @@ void AddStatusRoutes(httplib::Server& server, const ApiContext& api) {
                    context.calibrated = calibration.calibration.has_value();
                    if (context.calibrated) context.calibration_age_s = calibration.age_s;
                    context.uptime_s = UptimeSeconds();
+                   if (api.mqtt_stats) context.mqtt = api.mqtt_stats();
                    res.status = 200;
                    res.set_content(api.service.metrics().Text(context),
                                    "text/plain; version=0.0.4; charset=utf-8");
@@ -203,7 +204,7 @@ void HttpApi::Register(httplib::Server& server) {
         spdlog::debug("http {} {} -> {}", req.method, req.path, res.status);
     });
 
-    const ApiContext api{config_, service_, store_, loop_alive_};
+    const ApiContext api{config_, service_, store_, loop_alive_, mqtt_stats_};
     AddStatusRoutes(server, api);
     AddMeasurementRoutes(server, api);
     AddCalibrationRoutes(server, api);

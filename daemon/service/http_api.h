@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
@@ -14,6 +15,7 @@
 #include "daemon/service/daemon_config.h"
 #include "daemon/service/measurement_service.h"
 #include "daemon/service/measurement_store.h"
+#include "daemon/service/service_metrics.h"
 
 namespace httplib {
 class Server;
@@ -38,6 +40,10 @@ public:
     void Stop();
     // Returns true while every listener runs.
     bool Running() const;
+    // Adds the MQTT publisher's counters to GET /metrics; call before Start().
+    void set_mqtt_stats(std::function<std::optional<MqttStats>()> stats) {
+        mqtt_stats_ = std::move(stats);
+    }
     // Returns the bound TCP port (the configured one, or the one picked for port 0), or 0.
     int tcp_port() const { return tcp_port_; }
 
@@ -48,6 +54,7 @@ private:
     MeasurementService& service_;
     MeasurementStore& store_;
     std::function<bool()> loop_alive_;
+    std::function<std::optional<MqttStats>()> mqtt_stats_;
     std::vector<std::unique_ptr<httplib::Server>> servers_;
     std::vector<std::thread> threads_;
     int tcp_port_ = 0;

@@ -3,10 +3,12 @@
 // listener. The handlers only read the store and talk to the MeasurementService.
 
 #include <functional>
+#include <optional>
 
 #include "daemon/service/daemon_config.h"
 #include "daemon/service/measurement_service.h"
 #include "daemon/service/measurement_store.h"
+#include "daemon/service/service_metrics.h"
 
 namespace httplib {
 class Server;
@@ -20,6 +22,7 @@ struct ApiContext {
     MeasurementService& service;
     MeasurementStore& store;
     const std::function<bool()>& loop_alive;  // GET /v1/health: the service loop still runs
+    const std::function<std::optional<MqttStats>()>& mqtt_stats;  // GET /metrics; may be empty
 };
 
 // GET /v1/health, GET /v1/status, GET /v1/openapi.json, GET /metrics.

@@ -230,6 +230,7 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
     }
     LogMeasurement(r);
     metrics_.RecordMeasurement(r);
+    if (on_finished_) on_finished_(r);
     const bool station_ok = station->IsOpen();
     {
         std::lock_guard lock(mutex_);

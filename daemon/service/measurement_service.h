@@ -86,6 +86,11 @@ public:
 
     // Called (from any thread) whenever the state or the progress changes.
     void set_on_change(std::function<void()> on_change);
+    // Called (from the measurement's thread) with every finished measurement, once it is
+    // stored (or failed to be). Set before the first measurement starts.
+    void set_on_finished(std::function<void(const MeasurementResult&)> on_finished) {
+        on_finished_ = std::move(on_finished);
+    }
 
 private:
     void Run(std::string id, std::filesystem::path scratch, std::shared_ptr<Station> station,
@@ -123,6 +128,7 @@ private:
     int finished_ = 0;
     std::thread worker_;
     std::function<void()> on_change_;
+    std::function<void(const MeasurementResult&)> on_finished_;
     std::unique_ptr<CalibrationHistory> history_;
     ServiceMetrics metrics_;  // null when it could not be opened
 };

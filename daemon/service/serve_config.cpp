@@ -26,6 +26,9 @@ Result<ServeConfig> LoadServeConfig(const std::filesystem::path& file,
     auto storage = ParseStorageConfig(root["storage"]);
     if (!storage) return fail(storage.error().message);
     config.storage = *storage;
+    auto mqtt = ParseMqttConfig(root["mqtt"]);
+    if (!mqtt) return fail(mqtt.error().message);
+    config.mqtt = *mqtt;
     auto station = ParseStationConfig(root);
     if (!station) return fail(station.error().message);
     config.station.station = std::move(*station);

@@ -1,5 +1,5 @@
 #pragma once
-// The whole config file of `boxd serve`: the daemon's `server:` and `storage:` sections plus
+// The whole config file of `boxd serve`: the daemon's `server:`, `storage:` and `mqtt:` sections plus
 // the station's `turntable:`, `camera:`, `capture:` and `calibration:` sections, with the
 // command line's --listen / --data-dir applied on top.
 
@@ -21,6 +21,7 @@ struct ServeOverrides {
 struct ServeConfig {
     ServerConfig server;
     StorageConfig storage;
+    MqttConfig mqtt;
     DeviceStationConfig station;
 };
 

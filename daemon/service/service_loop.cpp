@@ -11,8 +11,10 @@
 #include "daemon/service/http_api.h"
 #include "daemon/service/measurement_service.h"
 #include "daemon/service/measurement_store.h"
+#include "daemon/service/mqtt_publisher.h"
 #include "daemon/service/signal_flags.h"
 #include "daemon/service/systemd_notifier.h"
+#include "pipeline/json_text.h"
 
 namespace boxd {
 
@@ -44,6 +46,18 @@ std::string StatusLine(const ServiceSnapshot& s) {
     }
 }
 
+// The retained MQTT state: what a fleet's dashboard shows of the station. Only what changes with
+// the state (not the progress) so that a retained message is sent per change.
+std::string MqttState(const ServiceSnapshot& s, const std::string& station_id) {
+    nlohmann::json j{{"state", ServiceStateName(s.state)}, {"station_id", station_id}};
+    j["measurement_id"] = s.measurement_id.empty() ? nlohmann::json(nullptr)
+                                                   : nlohmann::json(s.measurement_id);
+    j["last_measurement_id"] = s.last_measurement_id.empty()
+                                   ? nlohmann::json(nullptr)
+                                   : nlohmann::json(s.last_measurement_id);
+    return JsonText(j);
+}
+
 class ServiceLoop {
 public:
     ServiceLoop(ServeConfig config, std::filesystem::path config_file, ServeOverrides overrides)
@@ -67,6 +81,7 @@ private:
     std::unique_ptr<MeasurementStore> store_;
     std::unique_ptr<MeasurementService> service_;
     std::unique_ptr<HttpApi> api_;
+    std::unique_ptr<MqttPublisher> mqtt_;  // with an mqtt: section
     std::atomic<long long> last_tick_ms_{0};
     std::string last_status_;
     bool reload_pending_ = false;
@@ -89,11 +104,22 @@ Status ServiceLoop::Run() {
     service_ = std::make_unique<MeasurementService>(*store_, MakeStation(config_),
                                                     config_.storage.keep_sessions);
     service_->set_on_change([] { WakeMainLoop(); });
+    if (config_.mqtt.enabled) {
+        auto mqtt = MqttPublisher::Start(config_.mqtt);
+        if (!mqtt) return BadConfig(mqtt.error().message);
+        mqtt_ = std::move(*mqtt);
+        service_->set_on_finished([this](const MeasurementResult& r) {
+            mqtt_->PublishMeasurement(r.id, JsonText(ToJson(r)));
+        });
+    }
     last_tick_ms_ = NowMs();
     api_ = std::make_unique<HttpApi>(config_.server, *service_, *store_, [this] {
         return NowMs() - last_tick_ms_.load() <
                std::chrono::duration_cast<std::chrono::milliseconds>(kStalledAfter).count();
     });
+    if (mqtt_) {
+        api_->set_mqtt_stats([this]() -> std::optional<MqttStats> { return mqtt_->Stats(); });
+    }
     if (Status s = api_->Start(); !s) return BadConfig(s.error().message);
 
     if (Status s = service_->OpenStation(); !s) {
@@ -136,9 +162,11 @@ Status ServiceLoop::Run() {
     service_->Abort();
     service_->Join();
     service_->station()->Shutdown();
+    if (mqtt_) mqtt_->Stop();  // the aborted run is sent first, then {"state": "offline"}
     api_->Stop();
     api_.reset();
     service_.reset();
+    mqtt_.reset();
     spdlog::info("stopped");
     return OkStatus();
 }
@@ -151,7 +179,9 @@ void ServiceLoop::Tick() {
         if (api_->Running()) notifier_.Watchdog();
         next_watchdog_ = Clock::now() + notifier_.watchdog_interval();
     }
-    const std::string status = StatusLine(service_->Snapshot());
+    const ServiceSnapshot snapshot = service_->Snapshot();
+    if (mqtt_) mqtt_->PublishState(MqttState(snapshot, config_.mqtt.station_id));
+    const std::string status = StatusLine(snapshot);
     if (status != last_status_) {
         last_status_ = status;
         notifier_.Status(status);
@@ -171,6 +201,10 @@ void ServiceLoop::Reload() {
     if (!(fresh->server == config_.server)) {
         spdlog::warn("reload: server.* changes take effect at the next restart");
         fresh->server = config_.server;
+    }
+    if (!(fresh->mqtt == config_.mqtt)) {
+        spdlog::warn("reload: mqtt.* changes take effect at the next restart");
+        fresh->mqtt = config_.mqtt;
     }
     if (fresh->storage.data_dir != config_.storage.data_dir) {
         spdlog::warn("reload: storage.data_dir changes take effect at the next restart");

@@ -124,6 +124,20 @@ std::string ServiceMetrics::Text(const MetricsContext& context) const {
         Sample(out, "boxd_calibration_age_seconds", "",
                static_cast<double>(*context.calibration_age_s));
     }
+    if (context.mqtt) {
+        const MqttStats& m = *context.mqtt;
+        Header(out, "boxd_mqtt_connected", "gauge", "1 while the MQTT broker is connected.");
+        Sample(out, "boxd_mqtt_connected", "", m.connected ? 1 : 0);
+        Header(out, "boxd_mqtt_published_total", "counter",
+               "Measurements the MQTT broker acknowledged.");
+        Sample(out, "boxd_mqtt_published_total", "", static_cast<double>(m.published));
+        Header(out, "boxd_mqtt_dropped_total", "counter",
+               "Measurements never published (queue full while the broker was away, or at stop).");
+        Sample(out, "boxd_mqtt_dropped_total", "", static_cast<double>(m.dropped));
+        Header(out, "boxd_mqtt_queued", "gauge",
+               "Measurements waiting for the broker or its acknowledgement.");
+        Sample(out, "boxd_mqtt_queued", "", static_cast<double>(m.queued));
+    }
     return out;
 }
 

@@ -27,12 +27,21 @@ struct Histogram {
     void Observe(double seconds);
 };
 
+// The MQTT publisher's counters (mqtt_publisher.h).
+struct MqttStats {
+    bool connected = false;
+    long long published = 0;  // measurements the broker acknowledged (PUBACK)
+    long long dropped = 0;    // measurements given up (queue full, or unsent at shutdown)
+    long long queued = 0;     // measurements waiting for the broker or its acknowledgement
+};
+
 // What the exposition needs beyond the counters, read by the caller at request time.
 struct MetricsContext {
     const char* state = "idle";          // ServiceStateName of the service's state
     std::optional<long long> calibration_age_s;  // nullopt: no calibration, or its age unknown
     bool calibrated = false;
     long long uptime_s = 0;
+    std::optional<MqttStats> mqtt;  // with an mqtt: section
 };
 
 class ServiceMetrics {
