@@ -42,10 +42,15 @@ struct Measurement {
             dims.length_m = fit.pca.extent_m[0];
             dims.width_m = fit.pca.extent_m[1];
             dims.height_m = fit.pca.extent_m[2];
+            dims.center_m = fit.pca.center_m;
+            dims.axes = fit.pca.axes;
         } else {
             dims.length_m = cuboid.length_m;
             dims.width_m = cuboid.width_m;
             dims.height_m = cuboid.height_m;
+            const Eigen::Vector2d a = cuboid.length_axis;
+            dims.center_m = {cuboid.center_m.x(), cuboid.center_m.y(), cuboid.height_m / 2.0};
+            dims.axes = {{{a.x(), a.y(), 0.0}, {-a.y(), a.x(), 0.0}, {0.0, 0.0, 1.0}}};
         }
         out.result.shape = cuboid.cuboid ? "cuboid" : "irregular";
         out.result.uncertainty_m =

@@ -68,7 +68,11 @@ json ToJson(const MeasurementResult& m) {
                            {"width_m", Round(d.width_m, 1e-5)},
                            {"height_m", Round(d.height_m, 1e-5)},
                            {"volume_m3", Round(d.volume_m3, 1e-7)},
-                           {"method", d.method}};
+                           {"method", d.method},
+                           {"center_m", Array3(d.center_m, 1e-5)},
+                           {"axes",
+                            {Array3(d.axes[0], 1e-6), Array3(d.axes[1], 1e-6),
+                             Array3(d.axes[2], 1e-6)}}};
     } else {
         j["dimensions"] = nullptr;
     }

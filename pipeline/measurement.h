@@ -23,6 +23,11 @@ struct MeasuredDimensions {
     double height_m = 0.0;
     double volume_m3 = 0.0;
     std::string method = "footprint";  // footprint | pca
+    // Where the box stands, in the table frame (an addition to SPEC section 5, like obb's): its
+    // centre and its axes (rows: length, width and height directions). The operator page draws
+    // it in the cloud.
+    std::array<double, 3> center_m{};
+    std::array<std::array<double, 3>, 3> axes{{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
 };
 
 struct OrientedBox {

@@ -147,7 +147,7 @@ Result<ServerConfig> ParseServerConfig(const YAML::Node& node) {
     if (auto s = CheckKeys(node, "server",
                            {"listen", "unix_socket", "unix_socket_mode", "unix_socket_group",
                             "bearer_token", "protect_reads", "max_body_bytes", "wait_timeout_s",
-                            "threads", "max_connections"});
+                            "threads", "max_connections", "web_dir", "three_js"});
         !s) {
         return s.error();
     }
@@ -161,7 +161,9 @@ Result<ServerConfig> ParseServerConfig(const YAML::Node& node) {
                      ReadKey(node, "server", "max_body_bytes", max_body),
                      ReadKey(node, "server", "wait_timeout_s", c.wait_timeout_s),
                      ReadKey(node, "server", "threads", c.threads),
-                     ReadKey(node, "server", "max_connections", c.max_connections)}) {
+                     ReadKey(node, "server", "max_connections", c.max_connections),
+                     ReadKey(node, "server", "web_dir", c.web_dir),
+                     ReadKey(node, "server", "three_js", c.three_js)}) {
         if (!s) return s.error();
     }
     if (max_body < 0) return ConfigError("server.max_body_bytes", "must not be negative");

@@ -35,6 +35,10 @@ struct ServerConfig {
     int wait_timeout_s = 600;                // longest a POST /v1/measure?wait=1 blocks
     int threads = 16;                        // HTTP worker threads (a ?wait=1 request holds one)
     int max_connections = 256;               // ... added on demand up to this many connections
+    // The operator page (GET /): its folder ("" finds the installed one, share/boxd/web beside
+    // the binary, or the source tree's daemon/web) and three.js (Debian's libjs-three).
+    std::string web_dir;
+    std::string three_js = "/usr/share/javascript/three/three.min.js";
 
     // Returns an error naming the first invalid field ("server.<field>: ..."), or Ok.
     Status Validate() const;

@@ -208,6 +208,7 @@ void HttpApi::Register(httplib::Server& server) {
     AddStatusRoutes(server, api);
     AddMeasurementRoutes(server, api);
     AddCalibrationRoutes(server, api);
+    AddPageRoutes(server, api);
 }
 
 Status HttpApi::Start() {

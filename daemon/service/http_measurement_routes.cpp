@@ -14,14 +14,6 @@ using Response = httplib::Response;
 
 namespace {
 
-std::string ReadFile(const std::filesystem::path& path, bool& ok) {
-    std::ifstream in(path, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    ok = static_cast<bool>(in) || in.eof();
-    return ss.str();
-}
-
 // Whether `r` is a finished result that could not be stored (a full disk): it is answered with
 // 507 Insufficient Storage, never as a stored measurement.
 bool NotStored(const MeasurementResult& r) {

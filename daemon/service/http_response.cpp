@@ -3,6 +3,8 @@
 #include <spdlog/spdlog.h>
 
 #include <exception>
+#include <fstream>
+#include <sstream>
 
 #include "daemon/service/service_json.h"
 #include "pipeline/json_text.h"
@@ -66,6 +68,14 @@ std::optional<json> JsonObjectBody(const Request& req, Response& res, bool requi
         return std::nullopt;
     }
     return body;
+}
+
+std::string ReadFile(const std::filesystem::path& path, bool& ok) {
+    std::ifstream in(path, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    ok = static_cast<bool>(in) || in.eof();
+    return ss.str();
 }
 
 }  // namespace boxd

@@ -9,6 +9,7 @@
 #include <httplib.h>
 // clang-format on
 
+#include <filesystem>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -32,6 +33,8 @@ void SetJson(httplib::Response& res, int http_status, const nlohmann::json& body
 httplib::Server::Handler Guarded(
     std::function<void(const httplib::Request&, httplib::Response&)> handler);
 
+// Returns the bytes of the file at `path`; `ok` says whether it could be read.
+std::string ReadFile(const std::filesystem::path& path, bool& ok);
 // Returns the value of a boolean query parameter ("1"/"true"/""/"0"/"false"; false when absent),
 // or nullopt when it has another value.
 std::optional<bool> BoolParam(const httplib::Request& req, const char* name);

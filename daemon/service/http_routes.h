@@ -32,5 +32,7 @@ void AddStatusRoutes(httplib::Server& server, const ApiContext& api);
 void AddMeasurementRoutes(httplib::Server& server, const ApiContext& api);
 // POST /v1/calibrate, GET /v1/calibration.
 void AddCalibrationRoutes(httplib::Server& server, const ApiContext& api);
+// GET / (the operator page) and GET /three.min.js.
+void AddPageRoutes(httplib::Server& server, const ApiContext& api);
 
 }  // namespace boxd

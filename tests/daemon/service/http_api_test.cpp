@@ -185,7 +185,7 @@ TEST_F(HttpApiTest, BadRequestsGetTheirCodesAndTheDaemonKeepsServing) {
     ExpectError(client_->Post("/v1/measure?wait=maybe", "", "application/json"), 400,
                 "BAD_REQUEST");
     ExpectError(client_->Get("/v1/nope"), 404, "NOT_FOUND");
-    ExpectError(client_->Get("/"), 404, "NOT_FOUND");
+    ExpectError(client_->Get("/index.html"), 404, "NOT_FOUND");  // only / serves the page
     ExpectError(client_->Delete("/v1/measurements/last"), 404, "NOT_FOUND");
     ExpectError(client_->Post("/v1/calibrate", "{\"reference_m\": [0.4, 0.3]}", "application/json"),
                 400, "BAD_REQUEST");
@@ -345,6 +345,31 @@ TEST_F(HttpApiTest, MetricsCountWhatFinishedByStatusReasonAndFault) {
     EXPECT_EQ(s.at("boxd_state{state=\"error\"}"), 1);  // the turntable fault is the last word
     EXPECT_EQ(s.at("boxd_calibrated"), 1);
     EXPECT_EQ(s.at("boxd_calibration_age_seconds"), 42);
+}
+
+TEST_F(HttpApiTest, TheOperatorPageAndThreeJsAreServedFromDisk) {
+    auto page = client_->Get("/");
+    ASSERT_TRUE(page);
+    ASSERT_EQ(page->status, 200) << page->body;
+    EXPECT_EQ(page->get_header_value("Content-Type"), "text/html; charset=utf-8");
+    EXPECT_NE(page->body.find(R"(<script src="/three.min.js">)"), std::string::npos);
+    auto three = client_->Get("/three.min.js");
+    ASSERT_TRUE(three);
+    ASSERT_EQ(three->status, 200);
+    EXPECT_GT(three->body.size(), 100000u);  // Debian's libjs-three, not a download
+}
+
+TEST_F(HttpApiTest, AMissingPageOrThreeJsIs404NamingTheKey) {
+    api_.reset();
+    ServerConfig config;
+    config.listen = "127.0.0.1:0";
+    config.web_dir = (dir_ / "no-web").string();
+    config.three_js = (dir_ / "none.js").string();
+    StartApi(config);
+    ExpectError(client_->Get("/index.html"), 404, "NOT_FOUND");  // only / serves the page
+    EXPECT_NE(client_->Get("/")->body.find("server.web_dir"), std::string::npos);
+    ExpectError(client_->Get("/three.min.js"), 404, "NOT_FOUND");
+    EXPECT_NE(client_->Get("/three.min.js")->body.find("server.three_js"), std::string::npos);
 }
 
 TEST_F(HttpApiTest, AbortStopsTheTableAndRecordsTheAbortedMeasurement) {
