@@ -12,15 +12,8 @@
 #include <set>
 #include <sstream>
 
-#include "daemon/service/http_api.h"
-#include "daemon/service/measurement_service.h"
-#include "daemon/service/measurement_store.h"
+#include "tests/support/http_api_fixture.h"
 #include "tests/support/run_command.h"
-#include "tests/support/scripted_station.h"
-#include "tests/support/temp_dir.h"
-
-// After the project headers: <resolv.h> (through httplib) defines _res, a name Eigen uses.
-#include <httplib.h>
 
 namespace boxd {
 namespace {
@@ -87,26 +80,8 @@ TEST(OpenApi, EveryRegisteredRouteIsDescribedAndNothingElse) {
     }
 }
 
-class OpenApiServed : public ::testing::Test {
+class OpenApiServed : public test::HttpApiTest {
 protected:
-    void SetUp() override {
-        auto store = MeasurementStore::Open(dir_.path(), 50);
-        ASSERT_TRUE(store) << store.error().message;
-        store_ = std::move(*store);
-        station_ = std::make_shared<ScriptedStation>();
-        service_ = std::make_unique<MeasurementService>(*store_, station_, false);
-        ASSERT_TRUE(service_->OpenStation());
-        ServerConfig config;
-        config.listen = "127.0.0.1:0";
-        api_ = std::make_unique<HttpApi>(config, *service_, *store_, [] { return true; });
-        ASSERT_TRUE(api_->Start());
-        client_ = std::make_unique<httplib::Client>("127.0.0.1", api_->tcp_port());
-        client_->set_read_timeout(20, 0);
-    }
-    void TearDown() override {
-        api_.reset();
-        service_.reset();
-    }
     // Keeps `res` to be validated as the response `status` of `method` `path` (a template).
     void Keep(const std::string& method, const std::string& path, const httplib::Result& res,
               int status) {
@@ -118,12 +93,6 @@ protected:
             {{"method", method}, {"path", path}, {"status", status}, {"file", file.string()}});
     }
 
-    test::TempDir dir_;
-    std::unique_ptr<MeasurementStore> store_;
-    std::shared_ptr<ScriptedStation> station_;
-    std::unique_ptr<MeasurementService> service_;
-    std::unique_ptr<HttpApi> api_;
-    std::unique_ptr<httplib::Client> client_;
     json manifest_ = json::array();
 };
 
@@ -148,9 +117,7 @@ TEST_F(OpenApiServed, RealResponsesOfTheMainRoutesValidateAgainstTheirSchemas) {
     Keep("get", "/v1/status", client_->Get("/v1/status"), 200);  // measuring, with progress
     Keep("post", "/v1/measure", client_->Post("/v1/measure", "", "application/json"), 409);
     station_->hold = false;
-    for (int i = 0; i < 2000 && service_->Busy(); ++i) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    WaitUntilIdle();
     Keep("get", "/v1/measurements", client_->Get("/v1/measurements?limit=10"), 200);
     Keep("get", "/v1/measurements", client_->Get("/v1/measurements?limit=0"), 400);
     Keep("get", "/v1/measurements/{id}", client_->Get("/v1/measurements/m-000001"), 200);

@@ -165,6 +165,10 @@ TEST(ServeSimStation, MeasuresTheSimulatedBoxAndServesItAcrossKill9) {
         EXPECT_NEAR(samples.at("boxd_measurement_cycle_seconds_sum"),
                     first["timing_ms"]["total"].get<double>() / 1e3, 1e-3);
         EXPECT_EQ(samples.at("boxd_calibrated"), 1);
+        const json openapi = daemon.GetJson("/v1/openapi.json");
+        for (const char* path : {"/", "/v1/measure", "/v1/measurements/{id}", "/metrics"}) {
+            EXPECT_TRUE(openapi["paths"].contains(path)) << path;
+        }
         auto cloud = client.Get("/v1/measurements/m-000001/cloud.ply");
         ASSERT_TRUE(cloud);
         EXPECT_EQ(cloud->status, 200);
