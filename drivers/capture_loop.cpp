@@ -3,6 +3,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <condition_variable>
@@ -94,6 +95,9 @@ Status CaptureConfig::Validate() const {
     if (grab_timeout_ms < 1 || grab_timeout_ms > 60'000) {
         return ConfigError("grab_timeout_ms", "must be 1..60000");
     }
+    if (sweep != "alternate" && sweep != "from_zero") {
+        return ConfigError("sweep", "must be alternate or from_zero");
+    }
     return OkStatus();
 }
 
@@ -103,6 +107,38 @@ std::vector<double> CaptureConfig::Angles() const {
     for (int i = 0; i < poses; ++i) angles.push_back(360.0 * i / poses);
     return angles;
 }
+
+namespace {
+
+// Where a sweep starts and which way it turns.
+struct Sweep {
+    double start_deg = 0.0;
+    double sign = 1.0;
+};
+
+// "from_zero": from 0 forwards. "alternate": from where the table stands (a table not yet homed
+// is homed by its first move, so it starts at 0), backwards when the sweep would otherwise end
+// farther from home than it starts (0 -> 340 forwards, then 340 -> 0 backwards).
+Sweep PlanSweep(Turntable& turntable, const CaptureConfig& config,
+                const std::vector<double>& angles) {
+    Sweep s;
+    if (config.sweep != "alternate" || angles.empty()) {
+        s.start_deg = angles.empty() ? 0.0 : angles[0];
+        return s;
+    }
+    auto state = turntable.State();
+    if (!state || !state->homed) return s;
+    // The drive reports in its own units; a hundredth of a degree is below any settling error.
+    s.start_deg = std::round(state->angle_deg * 100.0) / 100.0;
+    double span = 0.0;
+    for (double a : angles) span = std::max(span, std::abs(a - angles[0]));
+    if (std::abs(s.start_deg - span) < std::abs(s.start_deg + span)) s.sign = -1.0;
+    spdlog::debug("capture: sweep from {:.2f} deg, {}", s.start_deg,
+                  s.sign > 0 ? "forwards" : "backwards");
+    return s;
+}
+
+}  // namespace
 
 Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
                                const CaptureConfig& config, const CaptureStation& station,
@@ -127,10 +163,12 @@ Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
                                                 std::to_string(n) + "; the table was stopped"};
     };
 
+    const Sweep sweep = PlanSweep(turntable, config, angles);
     for (int k = 0; k < n; ++k) {
         if (callbacks.on_progress) callbacks.on_progress(k, n);
         if (Cancelled(callbacks)) return cancelled(k);
-        if (auto st = turntable.MoveTo(angles[k]); !st) {
+        const double relative = sweep.sign * (angles[k] - angles[0]);
+        if (auto st = turntable.MoveTo(sweep.start_deg + relative); !st) {
             if (Cancelled(callbacks)) return cancelled(k);
             StopTable(turntable);
             Error e = st.error();
@@ -141,7 +179,7 @@ Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
         if (!SleepUnlessCancelled(config.settle_ms, callbacks)) return cancelled(k);
 
         SessionPose pose;
-        pose.angle_deg = angles[k] - angles[0];
+        pose.angle_deg = relative;
         for (int f = 0; f < config.drop_frames + config.frames_per_pose; ++f) {
             if (Cancelled(callbacks)) return cancelled(k);
             auto frame = camera.Grab(timeout);
@@ -164,8 +202,8 @@ Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
                 SessionFramePath(static_cast<std::size_t>(k), pose.frames.size()));
             pose.frames.push_back(std::move(frame).value());
         }
-        spdlog::debug("capture: pose {} of {} at {:.2f} deg: {} frames", k + 1, n, angles[k],
-                      pose.frames.size());
+        spdlog::debug("capture: pose {} of {} at {:.2f} deg: {} frames", k + 1, n,
+                      sweep.start_deg + relative, pose.frames.size());
         session.poses.push_back(std::move(pose));
         if (callbacks.on_pose) callbacks.on_pose(session.poses.size() - 1, session.poses.back());
     }

@@ -23,6 +23,11 @@ struct CaptureConfig {
                                      // frames exposed while the table still moved)
     int settle_ms = 200;             // wait after "in position" before grabbing
     int grab_timeout_ms = 2000;      // per frame
+    // Where a sweep starts. "alternate": where the table stands, turning back the way the last
+    // sweep came when that leads nearer home (0, 20, ... 340, then 340, 320, ... 0): no turn
+    // back between parcels, and the table (and its cables) stays within one turn.
+    // "from_zero": every sweep from 0 in the positive direction (`boxd record` always).
+    std::string sweep = "alternate";
 
     // Returns an error naming the first invalid field ("capture.<field>: ..."), or Ok.
     Status Validate() const;
@@ -52,8 +57,8 @@ struct CaptureCallbacks {
 // Captures one session with an open camera: for each pose, moves the table, waits settle_ms,
 // drops drop_frames frames and keeps frames_per_pose raw frames. Returns the session (camera
 // intrinsics, `station` calibration and direction, source = the camera's driver name, commanded
-// angles relative to the first pose), or the first error: TURNTABLE_ERROR, CAMERA_ERROR, or
-// CANCELLED. The table is stopped on every error path.
+// angles relative to the first pose: negative for a sweep turning back), or the first error:
+// TURNTABLE_ERROR, CAMERA_ERROR, or CANCELLED. The table is stopped on every error path.
 Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
                                const CaptureConfig& config, const CaptureStation& station,
                                const CaptureCallbacks& callbacks = {});

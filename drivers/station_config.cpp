@@ -206,6 +206,7 @@ Result<CaptureConfig> ParseCaptureConfig(const YAML::Node& node) {
                               {"drop_frames", Value(c.drop_frames)},
                               {"settle_ms", Value(c.settle_ms)},
                               {"grab_timeout_ms", Value(c.grab_timeout_ms)},
+                              {"sweep", Value(c.sweep)},
                           });
         !st) {
         return st.error();

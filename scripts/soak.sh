@@ -1,14 +1,17 @@
 #!/usr/bin/env bash
-# Memory soak benchmark: runs `boxd serve` on the simulated station (config/sim.yaml), makes N
-# measurements over HTTP one after the other and prints the daemon's resident memory after each.
+# Soak and cycle benchmark: runs `boxd serve` on the simulated station (CONFIG, default
+# config/sim.yaml), makes N measurements over HTTP one after the other and prints each one's
+# cycle (POST /v1/measure?wait=1 to its answer), capture and processing times and the daemon's
+# resident memory after it.
 # Usage: scripts/soak.sh [N=30] [PORT=18555]   (after a build: build/daemon/boxd)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 N=${1:-30}
 PORT=${2:-18555}
 BOXD=${BOXD:-build/daemon/boxd}
+CONFIG=${CONFIG:-config/sim.yaml}
 DATA=$(mktemp -d)
-"$BOXD" serve --config config/sim.yaml --listen "127.0.0.1:$PORT" --data-dir "$DATA/data" \
+"$BOXD" serve --config "$CONFIG" --listen "127.0.0.1:$PORT" --data-dir "$DATA/data" \
     2>"$DATA/serve.log" &
 PID=$!
 trap 'kill $PID 2>/dev/null; wait $PID 2>/dev/null; rm -rf "$DATA"' EXIT
@@ -19,6 +22,11 @@ done
 rss() { awk '/VmRSS/ {printf "%.1f", $2 / 1024}' "/proc/$PID/status"; }
 echo "started: RSS $(rss) MB"
 for i in $(seq 1 "$N"); do
-    code=$(curl -s -X POST "localhost:$PORT/v1/measure?wait=1" -o /dev/null -w '%{http_code}')
-    echo "measurement $i: HTTP $code, RSS $(rss) MB"
+    code=$(curl -s -X POST "localhost:$PORT/v1/measure?wait=1" -o "$DATA/m.json" \
+        -w '%{http_code} %{time_total}')
+    times=$(python3 -c 'import json, sys
+t = json.load(open(sys.argv[1])).get("timing_ms", {})
+print("capture %.2f s, processing %.3f s" % (t.get("capture", 0) / 1e3, t.get("processing", 0) / 1e3))' \
+        "$DATA/m.json" 2>/dev/null || echo "no timing")
+    echo "measurement $i: HTTP ${code% *}, cycle ${code#* } s ($times), RSS $(rss) MB"
 done

@@ -61,7 +61,10 @@ int RunRecord(const RecordOptions& options) {
     callbacks.on_progress = [](int pose, int poses) {
         if (pose < poses) spdlog::info("capture: pose {} of {}", pose + 1, poses);
     };
-    auto session = CaptureSession(*devices->turntable, *devices->camera, devices->capture,
+    // A recording keeps the fixed schedule: from 0, forwards.
+    CaptureConfig capture = devices->capture;
+    capture.sweep = "from_zero";
+    auto session = CaptureSession(*devices->turntable, *devices->camera, capture,
                                   devices->station, callbacks);
     devices->camera->Close();
     std::signal(SIGINT, SIG_DFL);

@@ -140,6 +140,42 @@ TEST(CaptureLoop, CapturesEveryPoseWithRawFrames) {
     EXPECT_NEAR(*angle, 240.0, 0.5);
 }
 
+TEST(CaptureLoop, AlternateSweepsStartWhereTheTableStandsAndTurnBack) {
+    SimulatorThread sim(FastSimulator());
+    auto table = Connect(sim.port());
+    ASSERT_TRUE(table);
+    SimulatedCamera camera(SmallCamera(), AngleOf(*table));
+    ASSERT_TRUE(camera.Open().ok());
+    CaptureStation station;
+    station.calibration = camera.Scene().recorded_calibration;
+    CaptureConfig config = QuickCapture(4);
+    ASSERT_EQ(config.sweep, "alternate");
+
+    // Not homed yet: the first sweep starts at home and turns forwards.
+    auto first = CaptureSession(*table, camera, config, station);
+    ASSERT_TRUE(first.ok()) << first.error().message;
+    std::vector<double> angles;
+    for (const auto& p : first->poses) angles.push_back(p.angle_deg);
+    EXPECT_EQ(angles, (std::vector<double>{0.0, 90.0, 180.0, 270.0}));
+    EXPECT_NEAR(*table->CurrentAngleDeg(), 270.0, 0.5);
+
+    // The next parcel: from 270 back to 0, no turn to the start first.
+    auto second = CaptureSession(*table, camera, config, station);
+    ASSERT_TRUE(second.ok()) << second.error().message;
+    angles.clear();
+    for (const auto& p : second->poses) angles.push_back(p.angle_deg);
+    EXPECT_EQ(angles, (std::vector<double>{0.0, -90.0, -180.0, -270.0}));
+    EXPECT_NEAR(*table->CurrentAngleDeg(), 0.0, 0.5);
+
+    // from_zero turns back to 0 and sweeps forwards every time.
+    config.sweep = "from_zero";
+    ASSERT_TRUE(table->MoveTo(180.0).ok());
+    auto fixed = CaptureSession(*table, camera, config, station);
+    ASSERT_TRUE(fixed.ok()) << fixed.error().message;
+    EXPECT_DOUBLE_EQ(fixed->poses[1].angle_deg, 90.0);
+    EXPECT_NEAR(*table->CurrentAngleDeg(), 270.0, 0.5);
+}
+
 TEST(CaptureLoop, CancellationStopsTheTableMidMove) {
     SimulatorThread sim(FastSimulator());
     auto table = Connect(sim.port(), 30.0);  // 0 -> 180 takes 6 s at 30 °/s
@@ -232,6 +268,12 @@ TEST(CaptureLoop, CameraThatLostTheTableGivesCameraError) {
 }
 
 TEST(CaptureConfig, ValidateNamesTheField) {
+    {
+        CaptureConfig c;
+        c.sweep = "zigzag";
+        ASSERT_FALSE(c.Validate());
+        EXPECT_NE(c.Validate().error().message.find("capture.sweep"), std::string::npos);
+    }
     CaptureConfig c;
     c.frames_per_pose = 0;
     auto st = c.Validate();
