@@ -23,6 +23,11 @@ json Array3(const std::array<double, 3>& a, double step) {
     return json::array({Round(a[0], step), Round(a[1], step), Round(a[2], step)});
 }
 
+// A box's axes (rows), each component to a millionth.
+json Axes(const std::array<std::array<double, 3>, 3>& axes) {
+    return json::array({Array3(axes[0], 1e-6), Array3(axes[1], 1e-6), Array3(axes[2], 1e-6)});
+}
+
 }  // namespace
 
 const char* StatusName(MeasurementStatus s) {
@@ -70,9 +75,7 @@ json ToJson(const MeasurementResult& m) {
                            {"volume_m3", Round(d.volume_m3, 1e-7)},
                            {"method", d.method},
                            {"center_m", Array3(d.center_m, 1e-5)},
-                           {"axes",
-                            {Array3(d.axes[0], 1e-6), Array3(d.axes[1], 1e-6),
-                             Array3(d.axes[2], 1e-6)}}};
+                           {"axes", Axes(d.axes)}};
     } else {
         j["dimensions"] = nullptr;
     }
@@ -83,7 +86,7 @@ json ToJson(const MeasurementResult& m) {
             {"extent_m", Array3(b.extent_m, 1e-5)},
             {"volume_m3", Round(b.volume_m3, 1e-7)},
             {"center_m", Array3(b.center_m, 1e-5)},
-            {"axes", {Array3(b.axes[0], 1e-6), Array3(b.axes[1], 1e-6), Array3(b.axes[2], 1e-6)}},
+            {"axes", Axes(b.axes)},
             {"frame", b.frame}};
     } else {
         j["obb"] = nullptr;

@@ -1,7 +1,5 @@
 // The measurement routes: start one (and wait for it), the stored results and their clouds.
 #include <charconv>
-#include <fstream>
-#include <sstream>
 
 #include "daemon/service/http_response.h"
 #include "daemon/service/http_routes.h"

@@ -1,8 +1,6 @@
 // The operator page: GET / serves index.html of the web folder, GET /three.min.js the three.js
 // of Debian's libjs-three. Nothing is downloaded at run time; a missing file is a 404 that says
 // which file and which key.
-#include <unistd.h>
-
 #include <filesystem>
 
 #include "daemon/service/http_response.h"

@@ -53,12 +53,6 @@ MeasurementService::MeasurementService(MeasurementStore& store, std::shared_ptr<
     }
 }
 
-Result<std::vector<json>> MeasurementService::ListCalibrations(int limit) {
-    if (!history_)
-        return Error{ErrorCode::kStorageError, "the calibration history is not available"};
-    return history_->List(limit);
-}
-
 MeasurementService::~MeasurementService() {
     Abort();
     Join();
@@ -255,94 +249,6 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
     // A measurement frees a few hundred megabytes of clouds: hand them back to the system now
     // rather than keep them for the next one (glibc keeps freed memory in its arenas).
     malloc_trim(0);
-}
-
-struct MeasurementService::CalibrationJob {
-    BoxDimensions reference;
-    bool done = false;  // guarded by mutex_
-    Result<CalibrationRun> result = Error{ErrorCode::kInternal, "not run"};
-};
-
-Result<CalibrationRun> MeasurementService::Calibrate(const BoxDimensions& reference,
-                                                     std::chrono::milliseconds timeout) {
-    Result<std::thread> previous = Claim(true);
-    if (!previous) return previous.error();
-    if (previous->joinable()) previous->join();
-    auto job = std::make_shared<CalibrationJob>();
-    job->reference = reference;
-    {
-        std::lock_guard lock(mutex_);
-        worker_ = std::thread(&MeasurementService::RunCalibration, this, job, station_);
-    }
-    spdlog::info("calibration started, reference {:.4f} x {:.4f} x {:.4f} m", reference.length_m,
-                 reference.width_m, reference.height_m);
-    Notify();
-    std::unique_lock lock(mutex_);
-    if (!finished_cv_.wait_for(lock, timeout, [&] { return job->done; })) {
-        return Error{ErrorCode::kTimeout, "the calibration is still running"};
-    }
-    return job->result;
-}
-
-void MeasurementService::RecordCalibration(const BoxDimensions& reference,
-                                           const Result<CalibrationRun>& result) {
-    if (!history_) return;
-    CalibrationRecord record;
-    record.finished_at = UtcTimestampNow();
-    record.reference = reference;
-    if (result) {
-        record.report = result->report;
-    } else {
-        record.error = result.error();
-    }
-    if (Status s = history_->Record(record); !s) {
-        spdlog::error("calibration history: {}", s.error().message);
-    }
-}
-
-void MeasurementService::RunCalibration(std::shared_ptr<CalibrationJob> job,
-                                        std::shared_ptr<Station> station) {
-    JobContext ctx;
-    ctx.id = "calibration";
-    ctx.cancel = &cancel_;
-    ctx.progress = [this](const JobProgress& p) { SetProgress(p); };
-    Result<CalibrationRun> result = Error{ErrorCode::kInternal, "not run"};
-    try {
-        Status opened = station->IsOpen() ? OkStatus() : station->Open();
-        result = opened ? station->Calibrate(ctx, job->reference)
-                        : Result<CalibrationRun>(opened.error());
-    } catch (const std::exception& e) {
-        spdlog::critical("calibration: internal failure: {}", e.what());
-        station->RequestStop();
-        result = Error{ErrorCode::kInternal, e.what()};
-    }
-    if (!result && cancel_) {
-        result = Error{ErrorCode::kAborted, "calibration aborted: the daemon is stopping"};
-    }
-    if (result) {
-        spdlog::info("calibration done: the new calibration is in force");
-    } else {
-        spdlog::error("calibration failed: {}: {}", ErrorCodeName(result.error().code),
-                      result.error().message);
-    }
-    RecordCalibration(job->reference, result);
-    if (!result) metrics_.RecordFault(result.error().code);
-    const bool station_ok = station->IsOpen();
-    {
-        std::lock_guard lock(mutex_);
-        running_ = false;
-        calibrating_ = false;
-        progress_ = JobProgress{};
-        station_ok_ = station_ok;
-        if (!result) {
-            last_error_ = result.error();
-            last_error_at_ = UtcTimestampNow();
-        }
-        job->result = std::move(result);
-        job->done = true;
-    }
-    finished_cv_.notify_all();
-    Notify();
 }
 
 Result<MeasurementResult> MeasurementService::WaitFor(const std::string& id,

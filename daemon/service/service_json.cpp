@@ -70,4 +70,11 @@ json StatusJson(const ServiceSnapshot& s, const DeviceHealth& devices,
     return j;
 }
 
+json MqttStateJson(const ServiceSnapshot& s, const std::string& station_id) {
+    return {{"state", ServiceStateName(s.state)},
+            {"station_id", station_id},
+            {"measurement_id", OptionalString(s.measurement_id)},
+            {"last_measurement_id", OptionalString(s.last_measurement_id)}};
+}
+
 }  // namespace boxd

@@ -28,6 +28,11 @@ nlohmann::json ToJson(const CalibrationRun& run);
 
 // Returns the GET /v1/status body: state, progress (while running), devices, calibration age,
 // last error, last measurement, counters and uptime.
+// Returns the retained MQTT state of a station: {"state", "station_id", "measurement_id",
+// "last_measurement_id"}. Only what changes with the state (not the progress), so that a
+// retained message goes out per change.
+nlohmann::json MqttStateJson(const ServiceSnapshot& snapshot, const std::string& station_id);
+
 nlohmann::json StatusJson(const ServiceSnapshot& snapshot, const DeviceHealth& devices,
                           const CalibrationInForce& calibration, long long uptime_s);
 

@@ -12,6 +12,7 @@
 #include "daemon/service/measurement_service.h"
 #include "daemon/service/measurement_store.h"
 #include "daemon/service/mqtt_publisher.h"
+#include "daemon/service/service_json.h"
 #include "daemon/service/signal_flags.h"
 #include "daemon/service/systemd_notifier.h"
 #include "pipeline/json_text.h"
@@ -44,18 +45,6 @@ std::string StatusLine(const ServiceSnapshot& s) {
             return std::string(ServiceStateName(s.state)) +
                    (s.last_measurement_id.empty() ? "" : ", last " + s.last_measurement_id);
     }
-}
-
-// The retained MQTT state: what a fleet's dashboard shows of the station. Only what changes with
-// the state (not the progress) so that a retained message is sent per change.
-std::string MqttState(const ServiceSnapshot& s, const std::string& station_id) {
-    nlohmann::json j{{"state", ServiceStateName(s.state)}, {"station_id", station_id}};
-    j["measurement_id"] = s.measurement_id.empty() ? nlohmann::json(nullptr)
-                                                   : nlohmann::json(s.measurement_id);
-    j["last_measurement_id"] = s.last_measurement_id.empty()
-                                   ? nlohmann::json(nullptr)
-                                   : nlohmann::json(s.last_measurement_id);
-    return JsonText(j);
 }
 
 class ServiceLoop {
@@ -180,7 +169,7 @@ void ServiceLoop::Tick() {
         next_watchdog_ = Clock::now() + notifier_.watchdog_interval();
     }
     const ServiceSnapshot snapshot = service_->Snapshot();
-    if (mqtt_) mqtt_->PublishState(MqttState(snapshot, config_.mqtt.station_id));
+    if (mqtt_) mqtt_->PublishState(JsonText(MqttStateJson(snapshot, config_.mqtt.station_id)));
     const std::string status = StatusLine(snapshot);
     if (status != last_status_) {
         last_status_ = status;
