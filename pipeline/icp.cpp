@@ -67,7 +67,7 @@ Linearization Linearize(const OrientedPoints& source, const IcpTarget& target, c
         const Eigen::Vector3d n = tgt.normals[static_cast<std::size_t>(j)].cast<double>();
         const Eigen::Vector3f& ns = source.normals[i];
         const Eigen::Vector3d ns_t(c * ns.x() - sn * ns.y(), sn * ns.x() + c * ns.y(), ns.z());
-        if (std::abs(ns_t.dot(n)) < config.min_normal_dot) continue;
+        if (ns_t.dot(n) < config.min_normal_dot) continue;
         const double r = n.dot((pt - tgt.points[static_cast<std::size_t>(j)]).cast<double>());
         ++lin.matched;
         lin.sq_sum += r * r;

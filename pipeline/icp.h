@@ -21,7 +21,8 @@ struct IcpConfig {
     double max_solve_normal_z = 0.7;
     int min_correspondences = 30;
     // Pairs whose normals disagree by more than acos(min_normal_dot) are not the same surface
-    // (box corners); Geman-McClure weights with this scale damp the remaining outliers.
+    // (box corners; the two sides of a thin panel, whose normals face their cameras, see
+    // registration_cloud.h); Geman-McClure weights with this scale damp the remaining outliers.
     double min_normal_dot = 0.9;
     double robust_scale_m = 0.004;
     // Weight of an in-plane point-to-point term beside point-to-plane. Where the data leave a

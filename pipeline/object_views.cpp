@@ -17,7 +17,8 @@ ObjectViews SegmentObjectViews(const std::vector<DepthMap>& depths, const Camera
     ParallelFor(n, threads, [&](int k) {
         const auto i = static_cast<std::size_t>(k);
         out.views[i] = SegmentView(depths[i], camera, calibration, camera_to_table, segmentation);
-        out.clouds[i] = BuildRegistrationClouds(out.views[i].points, coarse_cloud, fine_cloud);
+        out.clouds[i] = BuildRegistrationClouds(out.views[i].points, coarse_cloud, fine_cloud,
+                                                 camera_to_table.translation().cast<float>());
         // A single view keeps every pixel: with no other view to fuse, its faces' edges are all
         // the footprint there is, and the fusion stride would cut them short by up to 3 pixels.
         if (n > 1) out.views[i].points = Points{};

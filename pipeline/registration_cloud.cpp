@@ -91,8 +91,9 @@ Points ReduceVoxels(const WeightedVoxels& base, double base_voxel_m,
     return std::move(v.centroids);
 }
 
-// Statistical outlier removal and normals of the voxel centroids.
-OrientedPoints Orient(const Points& voxels, const RegistrationCloudConfig& config) {
+// Statistical outlier removal and normals of the voxel centroids, facing `viewpoint`.
+OrientedPoints Orient(const Points& voxels, const RegistrationCloudConfig& config,
+                      const Eigen::Vector3f& viewpoint) {
     OrientedPoints out;
     if (voxels.size() < static_cast<std::size_t>(config.normal_neighbors) + 1) return out;
     pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
@@ -123,26 +124,31 @@ OrientedPoints Orient(const Points& voxels, const RegistrationCloudConfig& confi
         }
         if (n.curvature > config.max_surface_variation) continue;
         const pcl::PointXYZ& p = (*cloud)[i];
-        out.points.emplace_back(p.x, p.y, p.z);
-        out.normals.push_back(Eigen::Vector3f(n.normal_x, n.normal_y, n.normal_z).normalized());
+        const Eigen::Vector3f point(p.x, p.y, p.z);
+        Eigen::Vector3f normal = Eigen::Vector3f(n.normal_x, n.normal_y, n.normal_z).normalized();
+        if (normal.dot(viewpoint - point) < 0.0f) normal = -normal;
+        out.points.push_back(point);
+        out.normals.push_back(normal);
     }
     return out;
 }
 
 }  // namespace
 
-OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config) {
+OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config,
+                                      const Eigen::Vector3f& viewpoint) {
     return Orient(ReduceVoxels(VoxelGrid(points, nullptr, config.voxel_m), config.voxel_m, config),
-                  config);
+                  config, viewpoint);
 }
 
 RegistrationClouds BuildRegistrationClouds(const Points& points,
                                            const RegistrationCloudConfig& coarse,
-                                           const RegistrationCloudConfig& fine) {
+                                           const RegistrationCloudConfig& fine,
+                                           const Eigen::Vector3f& viewpoint) {
     const double base_voxel = std::min(coarse.voxel_m, fine.voxel_m);
     const WeightedVoxels base = VoxelGrid(points, nullptr, base_voxel);
-    return {Orient(ReduceVoxels(base, base_voxel, coarse), coarse),
-            Orient(ReduceVoxels(base, base_voxel, fine), fine)};
+    return {Orient(ReduceVoxels(base, base_voxel, coarse), coarse, viewpoint),
+            Orient(ReduceVoxels(base, base_voxel, fine), fine, viewpoint)};
 }
 
 }  // namespace boxd

@@ -23,9 +23,13 @@ struct RegistrationCloudConfig {
     Status Validate(const std::string& where) const;
 };
 
-// Returns the downsampled, outlier-free cloud of `points` with unit normals. Deterministic: the
-// voxel centroids come out in the order their voxels are first met in `points`.
-OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config);
+// Returns the downsampled, outlier-free cloud of `points` with unit normals, each turned towards
+// `viewpoint` (the camera that saw them, same frame): a surface is seen from its outer side, so
+// the two sides of a thin panel, millimetres apart, keep opposite normals and registration does
+// not take one for the other. Deterministic: the voxel centroids come out in the order their
+// voxels are first met in `points`.
+OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config,
+                                      const Eigen::Vector3f& viewpoint);
 
 // A view's two registration clouds: sparse for the coarse alignment, denser for the fine one.
 struct RegistrationClouds {
@@ -40,6 +44,7 @@ struct RegistrationClouds {
 // only when the voxels nest) at a fraction of the cost.
 RegistrationClouds BuildRegistrationClouds(const Points& points,
                                            const RegistrationCloudConfig& coarse,
-                                           const RegistrationCloudConfig& fine);
+                                           const RegistrationCloudConfig& fine,
+                                           const Eigen::Vector3f& viewpoint);
 
 }  // namespace boxd

@@ -167,10 +167,17 @@ double RegistrationRmse(const FusedCloud& cloud) {
     for (std::size_t i = 0; i < cloud.points.size(); ++i) {
         views[cloud.view[i]].push_back(cloud.points[i]);
     }
+    // View k's camera, metres away at its azimuth (CloudBuilder::Emit) and above.
+    auto camera = [](int k) {
+        const double az = 2.0 * M_PI * k / kViews + 0.1;
+        return Eigen::Vector3f(static_cast<float>(3.0 * std::cos(az)),
+                               static_cast<float>(3.0 * std::sin(az)), 1.5f);
+    };
     double sum = 0.0;
     for (int k = 0; k < kViews; ++k) {
-        const OrientedPoints source = BuildRegistrationCloud(views[k], reg.fine_cloud);
-        const IcpTarget target(BuildRegistrationCloud(views[(k + 1) % kViews], reg.fine_cloud),
+        const int next = (k + 1) % kViews;
+        const OrientedPoints source = BuildRegistrationCloud(views[k], reg.fine_cloud, camera(k));
+        const IcpTarget target(BuildRegistrationCloud(views[next], reg.fine_cloud, camera(next)),
                                reg.fine.max_correspondence_m);
         sum += AlignIcp(source, target, Se2{}, reg.fine).rmse;
     }

@@ -27,6 +27,9 @@ Points BoxView(double sigma, unsigned seed) {
     return pts;
 }
 
+// BoxView's camera: in front of its +x and +y faces and above.
+const Eigen::Vector3f kViewpoint(1.0f, 1.0f, 1.0f);
+
 Points Move(const Points& pts, const Se2& t) {
     Points out;
     for (const auto& p : pts) out.push_back(t.Apply(p));
@@ -39,8 +42,8 @@ TEST(AlignIcp, RecoversKnownPlanarMotionCoarseThenFine) {
     const Se2 truth{0.012, -0.008, 3.0 * M_PI / 180.0};
     // The source is the same scene seen after the inverse motion: truth maps it back.
     const Points source_pts = Move(BoxView(0.0005, 2), truth.Inverse());
-    IcpTarget target(BuildRegistrationCloud(target_pts, cloud_cfg), 0.01);
-    const OrientedPoints source = BuildRegistrationCloud(source_pts, cloud_cfg);
+    IcpTarget target(BuildRegistrationCloud(target_pts, cloud_cfg, kViewpoint), 0.01);
+    const OrientedPoints source = BuildRegistrationCloud(source_pts, cloud_cfg, truth.Inverse().Apply(kViewpoint));
     IcpConfig coarse;
     coarse.max_correspondence_m = 0.03;
     const IcpResult c = AlignIcp(source, target, Se2{}, coarse);
@@ -61,8 +64,9 @@ TEST(AlignIcp, RecoversKnownPlanarMotionCoarseThenFine) {
 TEST(AlignIcp, ReportsNoOverlap) {
     const RegistrationCloudConfig cloud_cfg;
     const Points pts = BoxView(0.0, 3);
-    IcpTarget target(BuildRegistrationCloud(pts, cloud_cfg), 0.01);
-    const OrientedPoints far = BuildRegistrationCloud(Move(pts, Se2{1.0, 0.0, 0.0}), cloud_cfg);
+    IcpTarget target(BuildRegistrationCloud(pts, cloud_cfg, kViewpoint), 0.01);
+    const OrientedPoints far = BuildRegistrationCloud(Move(pts, Se2{1.0, 0.0, 0.0}), cloud_cfg,
+                                                      Se2{1.0, 0.0, 0.0}.Apply(kViewpoint));
     const IcpResult r = AlignIcp(far, target, Se2{}, IcpConfig{});
     EXPECT_FALSE(r.converged);
     EXPECT_EQ(r.fitness, 0.0);
@@ -74,6 +78,29 @@ TEST(IcpConfig, ValidateNamesField) {
     const Status s = c.Validate("registration.fine");
     ASSERT_FALSE(s.ok());
     EXPECT_NE(s.error().message.find("registration.fine.max_correspondence_m"), std::string::npos);
+}
+
+TEST(AlignIcp, TheTwoSidesOfAThinPanelAreNotTheSameSurface) {
+    // A 3 mm panel standing in the plane x = 0: one view sees its front (x = 0, from +x), the
+    // other its back (x = -0.003, from -x). Within the correspondence gate and parallel, the two
+    // sides would pass for one surface and pull the views 3 mm together; their normals face
+    // their own cameras, opposite ways, so no pair forms.
+    auto side = [](float x) {
+        Points pts;
+        for (float y = -0.15f; y <= 0.15f; y += 0.003f) {
+            for (float z = 0.0f; z <= 0.2f; z += 0.003f) pts.emplace_back(x, y, z);
+        }
+        return pts;
+    };
+    const RegistrationCloudConfig cloud_cfg;
+    IcpTarget front(BuildRegistrationCloud(side(0.0f), cloud_cfg, Eigen::Vector3f(1, 0, 0.5)),
+                    0.01);
+    const OrientedPoints back =
+        BuildRegistrationCloud(side(-0.003f), cloud_cfg, Eigen::Vector3f(-1, 0, 0.5));
+    ASSERT_GT(back.points.size(), 100u);
+    const IcpResult r = AlignIcp(back, front, Se2{}, IcpConfig{});
+    EXPECT_EQ(r.correspondences, 0);
+    EXPECT_FALSE(r.converged);
 }
 
 }  // namespace

@@ -98,7 +98,8 @@ TEST(SegmentObjectViews, RegistrationCloudsOfEachViewsObjectPoints) {
                                                 LookingDown(), SmallVolume());
         ASSERT_FALSE(alone.points.empty());
         const RegistrationClouds expected =
-            BuildRegistrationClouds(alone.points, reg.coarse_cloud, reg.fine_cloud);
+            BuildRegistrationClouds(alone.points, reg.coarse_cloud, reg.fine_cloud,
+                                    LookingDown().translation().cast<float>());
         ExpectSamePoints(ov.clouds[k].coarse.points, expected.coarse.points);
         ExpectSamePoints(ov.clouds[k].fine.points, expected.fine.points);
         ExpectSamePoints(ov.clouds[k].fine.normals, expected.fine.normals);

@@ -33,7 +33,8 @@ Scene MakeScene(int views) {
     Scene s;
     for (int k = 0; k < views; ++k) {
         s.clouds.push_back(BuildRegistrationClouds(kScene.View(kScene.TrueAngle(k), 200 + k),
-                                                   config.coarse_cloud, config.fine_cloud));
+                                                   config.coarse_cloud, config.fine_cloud,
+                                    kScene.Camera()));
         s.commanded.push_back(kScene.Commanded(k));
     }
     return s;

@@ -24,6 +24,9 @@ Points FlatGrid() {
     return Grid([](double a, double b) { return Eigen::Vector3f(a, b, 0.051); });
 }
 
+// A camera above the grids, in front of the wall x = 0.001 of the L below.
+const Eigen::Vector3f kAbove(0.5f, 0.06f, 0.5f);
+
 // A config without outlier removal, so that only the voxel grid decides the count.
 RegistrationCloudConfig NoOutlierRemoval(double voxel_m) {
     RegistrationCloudConfig c;
@@ -33,7 +36,7 @@ RegistrationCloudConfig NoOutlierRemoval(double voxel_m) {
 }
 
 TEST(BuildRegistrationCloud, VoxelCentroidsOfAKnownGrid) {
-    const OrientedPoints cloud = BuildRegistrationCloud(FlatGrid(), NoOutlierRemoval(0.006));
+    const OrientedPoints cloud = BuildRegistrationCloud(FlatGrid(), NoOutlierRemoval(0.006), kAbove);
     // 0.12 m / 6 mm = 20 voxels per side; each centroid is its voxel's centre (3 x 3 points).
     ASSERT_EQ(cloud.points.size(), 400u);
     ASSERT_EQ(cloud.normals.size(), 400u);
@@ -54,13 +57,21 @@ TEST(BuildRegistrationCloud, NormalsOfAPlaneAreThePlaneNormal) {
     // only float rounding (~1e-8 m over 6 mm neighbours, ~2e-6 rad) separates the two.
     const Points pts =
         Grid([](double a, double b) { return Eigen::Vector3f(a, b, 0.05 + 0.3 * a); });
-    const OrientedPoints cloud = BuildRegistrationCloud(pts, RegistrationCloudConfig{});
+    const OrientedPoints cloud = BuildRegistrationCloud(pts, RegistrationCloudConfig{}, kAbove);
     ASSERT_GT(cloud.points.size(), 350u);
     const Eigen::Vector3f n_true = Eigen::Vector3f(-0.3f, 0.0f, 1.0f).normalized();
     for (const Eigen::Vector3f& n : cloud.normals) {
         EXPECT_NEAR(n.norm(), 1.0f, 1e-5f);
-        EXPECT_LT(n.cross(n_true).norm(), 1e-4f) << n.transpose();
+        EXPECT_LT((n - n_true).norm(), 1e-4f) << n.transpose();  // towards the camera above
     }
+}
+
+TEST(BuildRegistrationCloud, NormalsFaceTheCameraThatSawThem) {
+    // The same plane seen from below: every normal turns down, towards that camera.
+    const OrientedPoints cloud =
+        BuildRegistrationCloud(FlatGrid(), RegistrationCloudConfig{}, Eigen::Vector3f(0, 0, -1));
+    ASSERT_GT(cloud.points.size(), 350u);
+    for (const Eigen::Vector3f& n : cloud.normals) EXPECT_NEAR(n.z(), -1.0f, 1e-5f);
 }
 
 TEST(BuildRegistrationCloud, RemovesIsolatedOutliers) {
@@ -73,7 +84,7 @@ TEST(BuildRegistrationCloud, RemovesIsolatedOutliers) {
     pts.emplace_back(0.2f, -0.3f, 0.5f);
     RegistrationCloudConfig config;
     ASSERT_GT(config.outlier_neighbors, 0);
-    const OrientedPoints cloud = BuildRegistrationCloud(pts, config);
+    const OrientedPoints cloud = BuildRegistrationCloud(pts, config, kAbove);
     EXPECT_EQ(cloud.points.size(), 400u);
     for (const Eigen::Vector3f& p : cloud.points) EXPECT_NEAR(p.z(), 0.051, 1e-6);
 }
@@ -86,10 +97,10 @@ TEST(BuildRegistrationCloud, DropsEdgePointsByMaxSurfaceVariation) {
     // 20 x 20 voxels per face, sharing the 20 corner voxels along the edge.
     RegistrationCloudConfig config = NoOutlierRemoval(0.006);
     config.max_surface_variation = 1.0 / 3.0;  // the largest possible: nothing is dropped
-    EXPECT_EQ(BuildRegistrationCloud(pts, config).points.size(), 780u);
+    EXPECT_EQ(BuildRegistrationCloud(pts, config, kAbove).points.size(), 780u);
 
     config.max_surface_variation = 0.02;
-    const OrientedPoints cloud = BuildRegistrationCloud(pts, config);
+    const OrientedPoints cloud = BuildRegistrationCloud(pts, config, kAbove);
     int far_floor = 0, far_wall = 0;
     for (std::size_t i = 0; i < cloud.points.size(); ++i) {
         const Eigen::Vector3f& p = cloud.points[i];
@@ -100,11 +111,11 @@ TEST(BuildRegistrationCloud, DropsEdgePointsByMaxSurfaceVariation) {
         // at the grid's border) all lie on the point's own face: its exact normal is kept.
         if (p.z() < 0.002f && p.x() > 0.018f) {
             ++far_floor;
-            EXPECT_NEAR(std::abs(n.z()), 1.0f, 1e-5f);
+            EXPECT_NEAR(n.z(), 1.0f, 1e-5f);
         }
         if (p.x() < 0.002f && p.z() > 0.018f) {
             ++far_wall;
-            EXPECT_NEAR(std::abs(n.x()), 1.0f, 1e-5f);
+            EXPECT_NEAR(n.x(), 1.0f, 1e-5f);
         }
     }
     EXPECT_EQ(far_floor, 17 * 20);
@@ -117,7 +128,7 @@ TEST(BuildRegistrationCloud, MaxPointsGrowsTheVoxel) {
     config.max_points = 100;
     // 400 voxels of 6 mm are 4 times too many: the voxel grows by sqrt(4) to 12 mm, which
     // holds 2 x 2 of the 6 mm voxels, 10 x 10 voxels of 12 mm.
-    const OrientedPoints cloud = BuildRegistrationCloud(FlatGrid(), config);
+    const OrientedPoints cloud = BuildRegistrationCloud(FlatGrid(), config, kAbove);
     ASSERT_EQ(cloud.points.size(), 100u);
     for (const Eigen::Vector3f& p : cloud.points) {
         for (int a = 0; a < 2; ++a) {
@@ -132,11 +143,11 @@ TEST(BuildRegistrationClouds, NestedVoxelsMatchDirectPasses) {
     const RegistrationCloudConfig fine = NoOutlierRemoval(0.006);
     coarse.max_surface_variation = 0.03;
     const Points pts = FlatGrid();
-    const RegistrationClouds both = BuildRegistrationClouds(pts, coarse, fine);
+    const RegistrationClouds both = BuildRegistrationClouds(pts, coarse, fine, kAbove);
     // 12 mm voxels nest 2 x 2 of the 6 mm ones, so regridding the fine centroids with their
     // weights is exact: both clouds equal a direct pass, point for point.
-    const OrientedPoints direct_coarse = BuildRegistrationCloud(pts, coarse);
-    const OrientedPoints direct_fine = BuildRegistrationCloud(pts, fine);
+    const OrientedPoints direct_coarse = BuildRegistrationCloud(pts, coarse, kAbove);
+    const OrientedPoints direct_fine = BuildRegistrationCloud(pts, fine, kAbove);
     ASSERT_EQ(both.coarse.points.size(), 100u);
     ASSERT_EQ(both.fine.points.size(), 400u);
     ASSERT_EQ(direct_coarse.points.size(), 100u);

@@ -45,7 +45,8 @@ protected:
         angles_ = new std::vector<double>();
         for (int k = 0; k < kViews; ++k) {
             views_->push_back(BuildRegistrationClouds(kScene.View(kScene.TrueAngle(k), 100 + k),
-                                                      config.coarse_cloud, config.fine_cloud));
+                                                      config.coarse_cloud, config.fine_cloud,
+                                    kScene.Camera()));
             angles_->push_back(kScene.Commanded(k));
         }
     }
@@ -142,7 +143,8 @@ TEST_F(RegisterViewPairsTest, PairThatCannotAlignIsLeftOut) {
     const RegistrationConfig config;
     Points moved = kScene.View(kScene.TrueAngle(3), 103);
     for (Eigen::Vector3f& p : moved) p.x() += 0.5f;
-    views[3] = BuildRegistrationClouds(moved, config.coarse_cloud, config.fine_cloud);
+    views[3] = BuildRegistrationClouds(moved, config.coarse_cloud, config.fine_cloud,
+                                    kScene.Camera());
     EdgeStats stats;
     const std::vector<PoseEdge> edges = RegisterViewPairs(views, *angles_, config, &stats);
     EXPECT_EQ(stats.attempted, 16);
@@ -163,7 +165,8 @@ TEST_F(RegisterViewPairsTest, PairSharingOnlyTheTopIsLeftOut) {
     for (const Eigen::Vector3f& p : kScene.View(kScene.TrueAngle(3), 103)) {
         if (p.z() > 0.1495f) top.push_back(p);
     }
-    views[3] = BuildRegistrationClouds(top, config.coarse_cloud, config.fine_cloud);
+    views[3] = BuildRegistrationClouds(top, config.coarse_cloud, config.fine_cloud,
+                                    kScene.Camera());
     EdgeStats stats;
     const std::vector<PoseEdge> edges = RegisterViewPairs(views, *angles_, config, &stats);
     EXPECT_EQ(stats.attempted, 16);

@@ -41,6 +41,9 @@ struct BoxOnTurntable {
     // more than grazing incidence. The top is always seen.
     bool Visible(int f, double angle) const { return FaceNormal(f, angle).y() <= -0.1; }
 
+    // Where the camera stands in every view's table frame: along -y and above.
+    static Eigen::Vector3f Camera() { return {0.0f, -1.0f, 0.8f}; }
+
     // The points the camera sees with the table at `angle`, in that view's table frame.
     Points View(double angle, unsigned seed) const {
         std::mt19937 rng(seed);
