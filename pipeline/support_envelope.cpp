@@ -16,10 +16,12 @@ struct Support {
     double se_forward = 0.0, se_backward = 0.0;
 };
 
-Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double sigma,
-                     double radius, double top, const EnvelopeConfig& config) {
-    const Eigen::Vector2d u(std::cos(phi), std::sin(phi)), v(-u.y(), u.x());
-    CellGrid<LayerCell> front(-radius, radius, 0.0, top, config.cell_along_m, config.cell_height_m);
+// The support along (cos φ, sin φ) read from cells of `cell_along` x `cell_height`.
+Support SupportAtScale(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector2d& u,
+                       double sigma, double radius, double top, double cell_along,
+                       double cell_height, const EnvelopeConfig& config) {
+    const Eigen::Vector2d v(-u.y(), u.x());
+    CellGrid<LayerCell> front(-radius, radius, 0.0, top, cell_along, cell_height);
     CellGrid<LayerCell> back = front;
     std::vector<double> max_s(front.cells.size(), -INFINITY), min_s(front.cells.size(), INFINITY);
     auto index = [&front](const LayerCell* c) {
@@ -46,17 +48,42 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
     }
     Support out;
     int judged = 0;
-    out.forward = LargestBound(front.cells, config, sigma, &out.se_forward, &judged);
-    out.backward = LargestBound(back.cells, config, sigma, &out.se_backward, &judged);
+    const double extent = std::max(cell_along, cell_height);
+    out.forward = LargestBound(front.cells, config, sigma, extent, &out.se_forward, &judged);
+    out.backward = LargestBound(back.cells, config, sigma, extent, &out.se_backward, &judged);
     return out;
+}
+
+// The support at the configured cells and at cells twice as large each way. Where the cloud is
+// sparse (a large object, a face seen obliquely, the subsample) a face's small cells may hold
+// too few readings to be judged at all, and the support would silently fall back to whatever
+// is dense inside it (a thin panel's two sides, millimetres apart, share their cells) —
+// a confident footprint far too small. The larger cells hold four times the readings; each
+// side takes the farther of the two reaches.
+Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double sigma,
+                     double radius, double top, const EnvelopeConfig& config) {
+    const Eigen::Vector2d u(std::cos(phi), std::sin(phi));
+    Support fine = SupportAtScale(pts, u, sigma, radius, top, config.cell_along_m,
+                                  config.cell_height_m, config);
+    const Support coarse = SupportAtScale(pts, u, sigma, radius, top, 2.0 * config.cell_along_m,
+                                          2.0 * config.cell_height_m, config);
+    if (coarse.forward > fine.forward) {
+        fine.forward = coarse.forward;
+        fine.se_forward = coarse.se_forward;
+    }
+    if (coarse.backward > fine.backward) {
+        fine.backward = coarse.backward;
+        fine.se_backward = coarse.se_backward;
+    }
+    return fine;
 }
 
 }  // namespace
 
 double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double radius,
                 const EnvelopeConfig& config, double* se) {
-    CellGrid<LayerCell> grid(-radius, radius, -radius, radius, 2.0 * config.cell_along_m,
-                             2.0 * config.cell_along_m);
+    const double cell = 2.0 * config.cell_along_m;
+    CellGrid<LayerCell> grid(-radius, radius, -radius, radius, cell, cell);
     std::vector<double> max_z(grid.cells.size(), -INFINITY);
     for (const Eigen::Vector3f& p : pts) {
         if (LayerCell* c = grid.At(p.x(), p.y())) {
@@ -71,7 +98,7 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double ra
         }
     }
     int judged = 0;
-    return LargestBound(grid.cells, config, sigma, se, &judged);
+    return LargestBound(grid.cells, config, sigma, cell, se, &judged);
 }
 
 Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma,

@@ -14,33 +14,55 @@ double UpperNormalQuantile(double q) {
     return 0.5 * (lo + hi);
 }
 
-double LayerCell::Facing() const {
+double LayerCell::Facing(double* off_plane) const {
     const Eigen::Vector3d mean = sum3 / n;
     const Eigen::Matrix3d cov = sum_outer / n - mean * mean.transpose();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    if (off_plane != nullptr) *off_plane = std::max(0.0, eig.eigenvalues()(0)) * n / (n - 1);
     return std::abs(eig.eigenvectors().col(0).z());
 }
 
 double MedianOfLargest(int m) { return UpperNormalQuantile(1.0 - std::pow(0.5, 1.0 / m)); }
 
 double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
-                    double noise_sigma, double* se, int* judged) {
-    // A cell's outer layer is either a surface facing the direction (its readings spread by the
-    // noise alone: the mean is the surface) or a surface running along it, a wall whose end is
-    // the extreme: its readings spread evenly over the layer, and the end lies √3 extent standard
-    // deviations (the spread beyond the noise) above their mean. The layer's own 3-D scatter says
-    // which: its normal points along the direction for a facing surface (within 60 degrees).
-    // The spread must also exceed the noise by more than a sample variance wanders (three of
-    // its standard errors, σ² √(2 / (n − 1))), or noise in a facing cell would pass for a wall.
-    auto reach = [noise_sigma](const LayerCell& c) {
-        const double var = std::max(0.0, (c.sum_sq - c.sum * c.sum / c.n) / std::max(1, c.n - 1));
-        const double noise_var = noise_sigma * noise_sigma;
-        const double excess_var = var - noise_var;
-        if (c.Facing() >= 0.5 || excess_var <= 3.0 * noise_var * std::sqrt(2.0 / (c.n - 1))) {
-            return c.Mean();
-        }
-        return c.Mean() + std::sqrt(3.0 * excess_var);
+                    double noise_sigma, double cell_extent_m, double* se, int* judged) {
+    // A cell's outer layer is one of three things; its own 3-D scatter says which.
+    //  - A surface facing the direction (its normal within 60 degrees of it): the mean is the
+    //    surface. Tilted by θ, it spreads over the cell's extent e by e·tan θ (at most the
+    //    layer's depth), and its high end lies somewhere in that spread above the mean (a
+    //    panel opened at 30 or 60 degrees): the uncertainty carries the spread's standard
+    //    deviation, spread / √12. (Reading the tilted patch's high end itself needs a finer
+    //    model than the cell: at any looser limit than 60 degrees, two faces meeting in a cell
+    //    pass for one tilted surface and widen flat boxes by millimetres.)
+    //  - One surface crossing the layer — a wall running along the direction, a steep panel,
+    //    a tube's flank: its readings lie on one plane (their variance off
+    //    it is the noise's) and spread evenly over the layer, so its high end lies √3 standard
+    //    deviations of that spread beyond the noise above their mean.
+    //  - Two surfaces sharing the cell (a corner: a face and the end of the next one): neither
+    //    model holds. The mean is the safe reach, and the uncertainty carries the layer.
+    // A variance must exceed the noise's by more than a sample variance wanders (three of its
+    // standard errors, σ² √(2 / (n − 1))) to count, or noise would pass for structure.
+    const double layer = config.layer_sigmas * noise_sigma;
+    const double noise_var = noise_sigma * noise_sigma;
+    struct Reach {
+        double value, extra_se;
     };
+    auto reach_of = [&](const LayerCell& c) -> Reach {
+        double off_plane = 0.0;
+        const double cos_t = std::min(1.0, c.Facing(&off_plane));
+        const double var = std::max(0.0, (c.sum_sq - c.sum * c.sum / c.n) / std::max(1, c.n - 1));
+        const double wander = 3.0 * noise_var * std::sqrt(2.0 / (c.n - 1));
+        if (cos_t >= 0.5) {
+            const double spread =
+                std::min(cell_extent_m * std::sqrt(1.0 - cos_t * cos_t) / cos_t, layer);
+            return {c.Mean(), spread > noise_sigma ? spread / std::sqrt(12.0) : 0.0};
+        }
+        if (var - noise_var <= wander) return {c.Mean(), 0.0};
+        if (off_plane > noise_var + wander) return {c.Mean(), layer / std::sqrt(12.0)};
+        return {c.Mean() + std::sqrt(3.0 * (var - noise_var)), 0.0};
+    };
+    auto reach = [&](const LayerCell& c) { return reach_of(c).value; };
+    auto slope_se = [&](const LayerCell& c) { return reach_of(c).extra_se; };
     int m = 0;
     double top = -INFINITY, top_se = 0.0;
     for (const LayerCell& c : cells) {
@@ -65,7 +87,7 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
         const double bound = reach(c) - z * c.StdError();
         if (bound > best) {
             best = bound;
-            *se = c.StdError();
+            *se = std::hypot(c.StdError(), slope_se(c));
         }
     }
     return best;

@@ -47,8 +47,10 @@ struct LayerCell : CellStats {
         sum3 += p;
         sum_outer += p * p.transpose();
     }
-    // Returns |cos| of the angle between the surface's normal and the direction judged.
-    double Facing() const;
+    // Returns |cos| of the angle between the surface's normal and the direction judged, and
+    // in `off_plane` (when given) the variance of the readings about their best plane: the
+    // noise for one surface, more for two (a corner's faces sharing the cell).
+    double Facing(double* off_plane = nullptr) const;
 };
 
 // Returns Φ⁻¹(0.5^(1/m)): the median of the largest of m standard normal draws.
@@ -58,10 +60,11 @@ double MedianOfLargest(int m);
 // (within two standard errors of it) compete, and the largest of their means is corrected by the
 // median of the largest of that many noise draws — noise alone then moves the estimate neither
 // out nor in. A flat face has many such cells (a large correction), a tube's tangent few.
-// `se` is the chosen cell's standard error, `judged` the number of cells with enough points.
-// Returns -inf when no cell is judged.
+// `cell_extent_m` is the cells' larger side; `se` receives the chosen cell's standard error (with
+// a sloped surface's spread), `judged` the number of cells with enough points. Returns -inf when
+// no cell is judged.
 double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
-                    double noise_sigma, double* se, int* judged);
+                    double noise_sigma, double cell_extent_m, double* se, int* judged);
 
 // A dense grid of cells over a rectangle of the (a, b) plane.
 template <typename Cell>

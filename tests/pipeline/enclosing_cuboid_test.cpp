@@ -38,8 +38,9 @@ constexpr double kStep = 0.004;        // sampling grid of each view
 // normal n goes to every view facing it, with that view's noise (sigma) and shift.
 class CloudBuilder {
 public:
-    CloudBuilder(double yaw, Eigen::Vector2d center, double sigma, unsigned seed)
-        : yaw_(yaw), center_(std::move(center)), rng_(seed), noise_(0.0, sigma) {
+    CloudBuilder(double yaw, Eigen::Vector2d center, double sigma, unsigned seed,
+                 double step = kStep)
+        : yaw_(yaw), center_(std::move(center)), step_(step), rng_(seed), noise_(0.0, sigma) {
         std::normal_distribution<double> shift(0.0, kViewShift);
         for (int k = 0; k < kViews; ++k) {
             shifts_.emplace_back(shift(rng_), shift(rng_), shift(rng_));
@@ -51,11 +52,11 @@ public:
     // false where the patch has no surface.
     void Patch(double a0, double a1, double b0, double b1,
                const std::function<bool(double, double, Eigen::Vector3d&, Eigen::Vector3d&)>& at) {
-        std::uniform_real_distribution<double> jitter(0.0, kStep);
+        std::uniform_real_distribution<double> jitter(0.0, step_);
         for (int k = 0; k < kViews; ++k) {
             const double ja = jitter(rng_), jb = jitter(rng_);
-            for (double a = a0 + ja; a < a1; a += kStep) {
-                for (double b = b0 + jb; b < b1; b += kStep) {
+            for (double a = a0 + ja; a < a1; a += step_) {
+                for (double b = b0 + jb; b < b1; b += step_) {
                     Eigen::Vector3d p, n;
                     if (at(a, b, p, n)) Emit(k, p, n);
                 }
@@ -82,6 +83,7 @@ private:
 
     double yaw_;
     Eigen::Vector2d center_;
+    double step_;
     std::mt19937 rng_;
     std::normal_distribution<double> noise_;
     std::vector<Eigen::Vector3d> shifts_;
@@ -100,8 +102,9 @@ struct Block {
 // block is not sampled). The +-y sides bulge by `bulge` at their middle, falling to zero at their
 // edges as a product of parabolas (a full carton's panel).
 FusedCloud SampleBlocks(const std::vector<Block>& blocks, double bulge, double yaw,
-                        Eigen::Vector2d center, unsigned seed, double sigma = kSigma) {
-    CloudBuilder builder(yaw, std::move(center), sigma, seed);
+                        Eigen::Vector2d center, unsigned seed, double sigma = kSigma,
+                        double step = kStep) {
+    CloudBuilder builder(yaw, std::move(center), sigma, seed, step);
     for (std::size_t i = 0; i < blocks.size(); ++i) {
         const Block& b = blocks[i];
         auto outside_others = [&](double x, double y) {
@@ -313,6 +316,23 @@ TEST(FitEnclosingCuboid, LShapeIsIrregularAndBoundedByItsBoundingBox) {
     // widening of the hull (perimeter 1.3 m x ~5 mm / 0.12 m^2 = +0.05 at most).
     EXPECT_GT(c.fill, 0.87);
     EXPECT_LT(c.fill, EnvelopeConfig{}.min_fill);
+}
+
+TEST(FitEnclosingCuboid, SparseFacesAreBoundedByLargerCells) {
+    // The L-shape sampled every 9 mm per view: a face's 12 mm cells hold a handful of readings,
+    // too few to judge, and only where faces crowd together (the inner corner, the edges) do
+    // small cells fill. Bounded by those alone, the footprint would shrink by centimetres;
+    // cells twice as large hold four times the readings and find the faces.
+    const double l = 0.40, w = 0.30, h = 0.20;
+    const std::vector<Block> blocks = {{-l / 2, l / 2, -w / 2, 0.0, h},
+                                       {-l / 2, 0.0, 0.0, w / 2, h}};
+    const FusedCloud cloud = SampleBlocks(blocks, 0.0, 0.7, {-0.01, 0.0}, 4, kSigma, 0.009);
+    const Fitted f = Fit(cloud);
+    ASSERT_TRUE(f.cuboid.ok()) << f.cuboid.error().message;
+    EXPECT_FALSE(f.cuboid->cuboid);
+    EXPECT_NEAR(f.cuboid->length_m, l, 0.003);
+    EXPECT_NEAR(f.cuboid->width_m, w, 0.003);
+    EXPECT_NEAR(f.cuboid->height_m, h, 0.003);
 }
 
 TEST(FitEnclosingCuboid, StepFillingItsFootprintIsIrregularByItsTop) {
