@@ -9,6 +9,7 @@
 #include "pipeline/enclosing_cuboid.h"
 #include "pipeline/fuse_and_fit.h"
 #include "pipeline/object_views.h"
+#include "pipeline/view_stream.h"
 #include "pipeline/refusal.h"
 #include "pipeline/register_views.h"
 #include "pipeline/registration_uncertainty.h"
@@ -79,42 +80,26 @@ double Confidence(const RegisteredViews& registered, int poses, double face_sigm
            std::min(1.0, static_cast<double>(points) / static_cast<double>(c.full_points));
 }
 
-}  // namespace
-
-Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<PreparedPose> poses,
-                                      const MeasureConfig& config, BoxMethod method,
-                                      const MonotonicMs& clock) {
-    if (Status s = config.Validate(); !s) return s.error();
-    if (poses.size() != session.poses.size()) {
-        return Error{ErrorCode::kInternal, "MeasurePrepared: " + std::to_string(poses.size()) +
-                                               " prepared poses for a session of " +
-                                               std::to_string(session.poses.size())};
-    }
+// Stages 4b to 7 on the views and edges of `stream`.
+MeasureOutput MeasureViews(const Session& session, ViewStream& stream,
+                           const MeasureConfig& config, BoxMethod method,
+                           const MonotonicMs& clock) {
     const int n = static_cast<int>(session.poses.size());
     const RefusalConfig& refuse = config.refusal;
     Measurement m(clock);
     MeasurementQuality& quality = m.out.result.quality;
     quality.poses = n;
 
-    // 1. The averaged depth map of every pose.
-    auto depths = UsableDepths(std::move(poses), refuse);
-    if (!depths) return m.Refused(depths.error());
+    // 1-3. Each pose's depth map, the table frame, each view's object points and clouds.
+    if (auto why = stream.Complete()) return m.Refused(*why);
+    const TablePlaneFit& table = stream.table();
+    ObjectViews& views = stream.views();
 
-    // 2. The table frame, refitted to the table top seen in every pose.
-    auto table = FitTablePlane(*depths, session.camera, session.calibration, config.table_plane);
-    if (!table) return m.Refused(table.error());
-
-    // 3. Each view's object points and registration clouds.
-    ObjectViews views = SegmentObjectViews(
-        *depths, session.camera, session.calibration, table->camera_to_table, config.segmentation,
-        config.registration.coarse_cloud, config.registration.fine_cloud, config.threads);
-    depths->clear();
-    if (auto why = CheckObjectViews(views, refuse)) return m.Refused(*why);
-    m.laps.Lap("preprocess");
-
-    // 4. Registration: ICP between views, then the pose graph.
-    auto registered = RegisterViews(views.clouds, session.PoseAnglesRad(), config.registration,
-                                    config.pose_graph, &m.laps);
+    // 4. Registration: the ICP edges the stream aligned, then the pose graph.
+    EdgeStats stats;
+    std::vector<PoseEdge> edges = stream.Edges(&stats);
+    auto registered = SolveViewGraph(std::move(edges), stats, session.PoseAnglesRad(),
+                                     config.pose_graph, &m.laps);
     if (!registered) return m.Refused(registered.error());
     quality.registration_rmse_m = registered->edges.mean_rmse_m;
     if (auto why = CheckRegisteredViews(*registered, n, refuse)) return m.Refused(*why);
@@ -135,7 +120,7 @@ Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<Prepar
 
     // 7. The smallest enclosing cuboid of the outermost surface, and the shape.
     const auto cuboid = FitEnclosingCuboid(fit.fused, fit.box, n, registered->edges.mean_rmse_m,
-                                           table->residual_sigma_m, config.envelope);
+                                           table.residual_sigma_m, config.envelope);
     m.laps.Lap("fit");
     std::array<double, 3> uncertainty{};
     if (cuboid) {
@@ -161,6 +146,38 @@ Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<Prepar
     quality.confidence = Confidence(*registered, n, fit.box ? fit.box->face_sigma_m : 0.0,
                                     quality.points, config.confidence);
     return m.Measured(fit, *cuboid, uncertainty, method);
+}
+
+}  // namespace
+
+Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<PreparedPose> poses,
+                                      const MeasureConfig& config, BoxMethod method,
+                                      const MonotonicMs& clock) {
+    if (Status s = config.Validate(); !s) return s.error();
+    if (poses.size() != session.poses.size()) {
+        return Error{ErrorCode::kInternal, "MeasurePrepared: " + std::to_string(poses.size()) +
+                                               " prepared poses for a session of " +
+                                               std::to_string(session.poses.size())};
+    }
+    ViewStream stream(session, static_cast<int>(session.poses.size()), config, clock);
+    stream.AddAll(session, std::move(poses));
+    return MeasureStreamed(session, stream, config, method, clock);
+}
+
+Result<MeasureOutput> MeasureStreamed(const Session& session, ViewStream& stream,
+                                      const MeasureConfig& config, BoxMethod method,
+                                      const MonotonicMs& clock) {
+    if (Status s = config.Validate(); !s) return s.error();
+    if (!stream.Matches(session)) {
+        return Error{ErrorCode::kInternal, "MeasureStreamed: the stream holds " +
+                                               std::to_string(stream.Added()) +
+                                               " poses, not those of the session"};
+    }
+    auto out = MeasureViews(session, stream, config, method, clock);
+    // The stages the stream did pose by pose count in their laps.
+    out.result.timing_ms["preprocess"] += stream.segment_ms();
+    out.result.timing_ms["registration"] += stream.align_ms();
+    return out;
 }
 
 Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig& config,

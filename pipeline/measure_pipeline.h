@@ -5,6 +5,7 @@
 //   2. the table frame refitted to the table top            table_plane.h
 //   3. each view's object points and registration clouds    object_views.h
 //   4. registration: ICP between views, the pose graph      register_views.h
+// (2 to the ICP of 4 pose by pose, as a capture delivers them: view_stream.h)
 //   5. fusion, 6. the box fits and view consistency        fuse_and_fit.h
 // with the refusal rules of refusal.h between them and the settings of measure_config.h.
 // Ids, timestamps, the capture and the total processing time are the caller's: the recipe
@@ -19,6 +20,7 @@
 #include "pipeline/result.h"
 #include "pipeline/session.h"
 #include "pipeline/stage_laps.h"
+#include "pipeline/view_stream.h"
 
 namespace boxd {
 
@@ -31,6 +33,13 @@ struct MeasureOutput {
 // order (`session.poses` supply the angles; their frames are not read again). Refusals are
 // results with status no_dim; the error path is for an invalid configuration only.
 Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<PreparedPose> poses,
+                                      const MeasureConfig& config, BoxMethod method,
+                                      const MonotonicMs& clock = {});
+
+// Returns the measurement of `session` whose poses all went through `stream` (a capture feeds
+// it pose by pose while the table turns): what remains after the last pose — the pose graph,
+// fusion and the fits. An error (INTERNAL) when the stream holds other poses than the session.
+Result<MeasureOutput> MeasureStreamed(const Session& session, ViewStream& stream,
                                       const MeasureConfig& config, BoxMethod method,
                                       const MonotonicMs& clock = {});
 

@@ -27,23 +27,27 @@ std::vector<PreparedPose> PrepareSession(const Session& session, const MeasureCo
     return prepared;
 }
 
+Result<DepthMap> UsableDepth(PreparedPose pose, std::size_t index, const RefusalConfig& refuse) {
+    if (!pose.error.empty()) {
+        return Error{ErrorCode::kInsufficientData, fmt::format("pose {}: {}", index, pose.error)};
+    }
+    const double valid = ValidFraction(pose.depth);
+    if (valid < refuse.min_pose_valid_fraction) {
+        return Error{ErrorCode::kInsufficientData,
+                     fmt::format("pose {} has valid depth readings in only {:.1f}% of its pixels",
+                                 index, 100.0 * valid)};
+    }
+    return std::move(pose.depth);
+}
+
 Result<std::vector<DepthMap>> UsableDepths(std::vector<PreparedPose> poses,
                                            const RefusalConfig& refuse) {
     if (poses.empty()) return Error{ErrorCode::kInsufficientData, "the session has no poses"};
     std::vector<DepthMap> depths(poses.size());
     for (std::size_t i = 0; i < poses.size(); ++i) {
-        if (!poses[i].error.empty()) {
-            return Error{ErrorCode::kInsufficientData,
-                         fmt::format("pose {}: {}", i, poses[i].error)};
-        }
-        depths[i] = std::move(poses[i].depth);
-        const double valid = ValidFraction(depths[i]);
-        if (valid < refuse.min_pose_valid_fraction) {
-            return Error{
-                ErrorCode::kInsufficientData,
-                fmt::format("pose {} has valid depth readings in only {:.1f}% of its pixels", i,
-                            100.0 * valid)};
-        }
+        auto depth = UsableDepth(std::move(poses[i]), i, refuse);
+        if (!depth) return depth.error();
+        depths[i] = std::move(*depth);
     }
     return depths;
 }

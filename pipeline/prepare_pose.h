@@ -26,6 +26,10 @@ PreparedPose PreparePose(const std::vector<DepthImage>& frames, double depth_uni
 // Returns every pose of `session` through PreparePose, on config.threads threads.
 std::vector<PreparedPose> PrepareSession(const Session& session, const MeasureConfig& config);
 
+// Returns pose `index`'s depth map, or INSUFFICIENT_DATA naming it when it cannot be used (its
+// frames could not be averaged, or too few of its pixels have a reading).
+Result<DepthMap> UsableDepth(PreparedPose pose, std::size_t index, const RefusalConfig& refuse);
+
 // Returns the prepared poses' depth maps in pose order, or INSUFFICIENT_DATA naming the pose
 // that cannot be used (its frames could not be averaged, or too few of its pixels have a
 // reading).

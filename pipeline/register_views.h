@@ -27,4 +27,10 @@ Result<RegisteredViews> RegisterViews(const std::vector<RegistrationClouds>& clo
                                       const RegistrationConfig& registration,
                                       const PoseGraphConfig& pose_graph, StageLaps* laps);
 
+// The second half of RegisterViews: the pose graph of the turntable model at `angles_rad` and
+// the pairwise `edges` already aligned (with their `stats`). Laps "optimization".
+Result<RegisteredViews> SolveViewGraph(std::vector<PoseEdge> edges, const EdgeStats& stats,
+                                       const std::vector<double>& angles_rad,
+                                       const PoseGraphConfig& pose_graph, StageLaps* laps);
+
 }  // namespace boxd

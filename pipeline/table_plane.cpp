@@ -69,23 +69,38 @@ Points BackProjectDepth(const DepthMap& depth, const CameraIntrinsics& camera,
     return out;
 }
 
+std::vector<Eigen::Vector3d> TableCandidates(const DepthMap& depth, const CameraIntrinsics& camera,
+                                             const StationCalibration& calibration,
+                                             const TablePlaneConfig& config) {
+    const Eigen::Isometry3d recorded = calibration.CameraToTable();
+    std::vector<Eigen::Vector3d> pts;
+    for (const Eigen::Vector3f& pc :
+         BackProjectDepth(depth, camera, calibration, config.pixel_stride)) {
+        const Eigen::Vector3d p = recorded * pc.cast<double>();
+        if (std::abs(p.z()) < config.search_band_m && p.head<2>().norm() < config.fit_radius_m) {
+            pts.push_back(p);
+        }
+    }
+    return pts;
+}
+
 Result<TablePlaneFit> FitTablePlane(const std::vector<DepthMap>& depths,
                                     const CameraIntrinsics& camera,
                                     const StationCalibration& calibration,
                                     const TablePlaneConfig& config) {
-    const Eigen::Isometry3d recorded = calibration.CameraToTable();
-    // Candidate table-top points in the recorded table frame.
     std::vector<Eigen::Vector3d> pts;
     for (const DepthMap& depth : depths) {
-        for (const Eigen::Vector3f& pc :
-             BackProjectDepth(depth, camera, calibration, config.pixel_stride)) {
-            const Eigen::Vector3d p = recorded * pc.cast<double>();
-            if (std::abs(p.z()) < config.search_band_m &&
-                p.head<2>().norm() < config.fit_radius_m) {
-                pts.push_back(p);
-            }
-        }
+        const std::vector<Eigen::Vector3d> more =
+            TableCandidates(depth, camera, calibration, config);
+        pts.insert(pts.end(), more.begin(), more.end());
     }
+    return FitTableCandidates(pts, calibration, config);
+}
+
+Result<TablePlaneFit> FitTableCandidates(const std::vector<Eigen::Vector3d>& pts,
+                                         const StationCalibration& calibration,
+                                         const TablePlaneConfig& config) {
+    const Eigen::Isometry3d recorded = calibration.CameraToTable();
     if (static_cast<int>(pts.size()) < config.min_points) {
         return Error{
             ErrorCode::kInsufficientData,

@@ -51,4 +51,13 @@ Result<TablePlaneFit> FitTablePlane(const std::vector<DepthMap>& depths,
                                     const StationCalibration& calibration,
                                     const TablePlaneConfig& config);
 
+// FitTablePlane in two steps: the candidate table-top points of one depth map (in the recorded
+// table frame), and the fit of candidates pooled from any number of maps.
+std::vector<Eigen::Vector3d> TableCandidates(const DepthMap& depth, const CameraIntrinsics& camera,
+                                             const StationCalibration& calibration,
+                                             const TablePlaneConfig& config);
+Result<TablePlaneFit> FitTableCandidates(const std::vector<Eigen::Vector3d>& candidates,
+                                         const StationCalibration& calibration,
+                                         const TablePlaneConfig& config);
+
 }  // namespace boxd

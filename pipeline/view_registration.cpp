@@ -2,8 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cmath>
-#include <set>
+#include <memory>
 #include <utility>
 
 #include "pipeline/parallel_for.h"
@@ -36,65 +37,71 @@ std::vector<Se2> TurntablePoses(const std::vector<double>& table_angles_rad) {
     return poses;
 }
 
-std::vector<PoseEdge> RegisterViewPairs(const std::vector<ViewClouds>& views,
-                                        const std::vector<double>& table_angles_rad,
-                                        const RegistrationConfig& config, EdgeStats* stats) {
-    const int n = static_cast<int>(views.size());
-    const std::vector<Se2> model = TurntablePoses(table_angles_rad);
-    // Pairs (i, j), i < j in cyclic index distance <= max_pose_step, within the angle limit.
-    std::set<std::pair<int, int>> pairs;
+bool IsViewPair(int i, int j, int poses, double angle_i_rad, double angle_j_rad,
+                const RegistrationConfig& config) {
+    const int d = j - i;
+    if (d <= 0 || d >= poses) return false;
+    if (std::min(d, poses - d) > config.max_pose_step) return false;
+    const double diff = std::abs(Se2::WrapAngle(angle_i_rad - angle_j_rad));
+    return diff * 180.0 / M_PI <= config.max_pair_angle_deg;
+}
+
+std::vector<std::pair<int, int>> ViewPairs(const std::vector<double>& table_angles_rad,
+                                           const RegistrationConfig& config) {
+    const int n = static_cast<int>(table_angles_rad.size());
+    std::vector<std::pair<int, int>> pairs;
+    auto consider = [&](int i, int j) {
+        const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
+        if (IsViewPair(i, j, n, table_angles_rad[ui], table_angles_rad[uj], config)) {
+            pairs.emplace_back(i, j);
+        }
+    };
+    // Forward steps, and the steps that close the loop from the last views to the first ones
+    // (those a forward step of a short session has not already counted).
     for (int i = 0; i < n; ++i) {
-        for (int step = 1; step <= config.max_pose_step && step < n; ++step) {
-            const int j = (i + step) % n;
-            const double diff = std::abs(Se2::WrapAngle(model[static_cast<std::size_t>(i)].yaw -
-                                                        model[static_cast<std::size_t>(j)].yaw));
-            if (diff * 180.0 / M_PI > config.max_pair_angle_deg) continue;
-            pairs.insert({std::min(i, j), std::max(i, j)});
+        for (int d = 1; d <= config.max_pose_step; ++d) {
+            if (i + d < n) consider(i, i + d);
+            if (n - d > config.max_pose_step && i + n - d < n) consider(i, i + n - d);
         }
     }
-    const std::vector<std::pair<int, int>> list(pairs.begin(), pairs.end());
-    // Targets with their search indices are built once per view.
-    std::vector<std::unique_ptr<IcpTarget>> coarse_targets(static_cast<std::size_t>(n));
-    std::vector<std::unique_ptr<IcpTarget>> fine_targets(static_cast<std::size_t>(n));
-    ParallelFor(n, config.threads, [&](int k) {
-        const auto i = static_cast<std::size_t>(k);
-        coarse_targets[i] =
-            std::make_unique<IcpTarget>(views[i].coarse, config.coarse.max_correspondence_m);
-        fine_targets[i] =
-            std::make_unique<IcpTarget>(views[i].fine, config.fine.max_correspondence_m);
-    });
-    std::vector<PoseEdge> edges(list.size());
-    std::vector<IcpResult> results(list.size());
-    std::vector<int> coarse_iterations(list.size());
-    ParallelFor(static_cast<int>(list.size()), config.threads, [&](int e) {
-        const auto [i, j] = list[static_cast<std::size_t>(e)];
-        const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
-        // View j into view i's frame: X_i⁻¹ ∘ X_j.
-        const Se2 init = model[ui].Inverse().Compose(model[uj]);
-        const IcpResult coarse =
-            AlignIcp(views[uj].coarse, *coarse_targets[ui], init, config.coarse);
-        const IcpResult fine =
-            AlignIcp(views[uj].fine, *fine_targets[ui], coarse.transform, config.fine);
-        results[static_cast<std::size_t>(e)] = fine;
-        coarse_iterations[static_cast<std::size_t>(e)] = coarse.iterations;
-        PoseEdge& edge = edges[static_cast<std::size_t>(e)];
-        edge.from = i;
-        edge.to = j;
-        edge.measured = fine.transform;
-        edge.information = fine.information;
-        edge.point_scatter = fine.point_scatter;
-        edge.loop_closure = !(j == i + 1);
-    });
+    std::sort(pairs.begin(), pairs.end());
+    return pairs;
+}
+
+ViewTargets::ViewTargets(const ViewClouds& clouds, const RegistrationConfig& config)
+    : coarse(clouds.coarse, config.coarse.max_correspondence_m),
+      fine(clouds.fine, config.fine.max_correspondence_m) {}
+
+PairAlignment AlignViewPair(int i, int j, const ViewClouds& view_j, const ViewTargets& target_i,
+                            const std::vector<Se2>& model, const RegistrationConfig& config) {
+    const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
+    const Se2 init = model[ui].Inverse().Compose(model[uj]);
+    const IcpResult coarse = AlignIcp(view_j.coarse, target_i.coarse, init, config.coarse);
+    PairAlignment out;
+    out.fine = AlignIcp(view_j.fine, target_i.fine, coarse.transform, config.fine);
+    out.coarse_iterations = coarse.iterations;
+    PoseEdge& edge = out.edge;
+    edge.from = i;
+    edge.to = j;
+    edge.measured = out.fine.transform;
+    edge.information = out.fine.information;
+    edge.point_scatter = out.fine.point_scatter;
+    edge.loop_closure = !(j == i + 1);
+    return out;
+}
+
+std::vector<PoseEdge> AcceptedEdges(const std::vector<PairAlignment>& alignments,
+                                    const RegistrationConfig& config, EdgeStats* stats) {
     std::vector<PoseEdge> accepted;
     EdgeStats st;
     double rmse_sum = 0.0;
-    for (std::size_t e = 0; e < list.size(); ++e) {
+    for (const PairAlignment& a : alignments) {
         ++st.attempted;
-        const IcpResult& r = results[e];
+        const IcpResult& r = a.fine;
         spdlog::debug(
             "registration: {}-{}: {}+{} iterations, fitness {:.2f}, rmse {:.2f} mm, "
             "motion ({:.1f}, {:.1f}) mm {:.2f} deg",
-            list[e].first, list[e].second, coarse_iterations[e], r.iterations, r.fitness,
+            a.edge.from, a.edge.to, a.coarse_iterations, r.iterations, r.fitness,
             r.rmse * 1000.0, r.transform.x * 1000.0, r.transform.y * 1000.0,
             r.transform.yaw * 180.0 / M_PI);
         // An alignment with too few upright correspondences never left its start: its
@@ -105,11 +112,32 @@ std::vector<PoseEdge> RegisterViewPairs(const std::vector<ViewClouds>& views,
         }
         ++st.accepted;
         rmse_sum += r.rmse;
-        accepted.push_back(edges[e]);
+        accepted.push_back(a.edge);
     }
     st.mean_rmse_m = st.accepted > 0 ? rmse_sum / st.accepted : 0.0;
     if (stats) *stats = st;
     return accepted;
+}
+
+std::vector<PoseEdge> RegisterViewPairs(const std::vector<ViewClouds>& views,
+                                        const std::vector<double>& table_angles_rad,
+                                        const RegistrationConfig& config, EdgeStats* stats) {
+    const int n = static_cast<int>(views.size());
+    const std::vector<Se2> model = TurntablePoses(table_angles_rad);
+    const std::vector<std::pair<int, int>> list = ViewPairs(table_angles_rad, config);
+    std::vector<std::unique_ptr<ViewTargets>> targets(static_cast<std::size_t>(n));
+    ParallelFor(n, config.threads, [&](int k) {
+        targets[static_cast<std::size_t>(k)] =
+            std::make_unique<ViewTargets>(views[static_cast<std::size_t>(k)], config);
+    });
+    std::vector<PairAlignment> alignments(list.size());
+    ParallelFor(static_cast<int>(list.size()), config.threads, [&](int e) {
+        const auto [i, j] = list[static_cast<std::size_t>(e)];
+        alignments[static_cast<std::size_t>(e)] = AlignViewPair(
+            i, j, views[static_cast<std::size_t>(j)], *targets[static_cast<std::size_t>(i)],
+            model, config);
+    });
+    return AcceptedEdges(alignments, config, stats);
 }
 
 }  // namespace boxd

@@ -2,6 +2,7 @@
 // Stages 3 and 4: initial poses from the turntable angles and the ICP edges of the pose graph
 // (neighbouring poses and loop closures between non-neighbours, last-to-first included).
 
+#include <utility>
 #include <vector>
 
 #include "pipeline/icp.h"
@@ -48,8 +49,39 @@ struct EdgeStats {
 // which maps view k's points back into the frame of pose 0.
 std::vector<Se2> TurntablePoses(const std::vector<double>& table_angles_rad);
 
-// Returns the graph edges: each selected pair is aligned coarse-then-fine from the turntable
-// model's relative pose; failed alignments are left out. Deterministic for any thread count.
+// Whether views i < j of a session of `poses` views, at turntable angles `angle_i_rad` and
+// `angle_j_rad`, are aligned: cyclic index distance at most max_pose_step, angles at most
+// max_pair_angle_deg apart.
+bool IsViewPair(int i, int j, int poses, double angle_i_rad, double angle_j_rad,
+                const RegistrationConfig& config);
+
+// Returns every pair (i, j), i < j, that IsViewPair, sorted.
+std::vector<std::pair<int, int>> ViewPairs(const std::vector<double>& table_angles_rad,
+                                           const RegistrationConfig& config);
+
+// One view's registration clouds with their search indices, built once.
+struct ViewTargets {
+    ViewTargets(const ViewClouds& clouds, const RegistrationConfig& config);
+    IcpTarget coarse, fine;
+};
+
+// The alignment of view j into view i's frame (X_i⁻¹ ∘ X_j), coarse then fine from `model`.
+struct PairAlignment {
+    PoseEdge edge;
+    IcpResult fine;
+    int coarse_iterations = 0;
+};
+PairAlignment AlignViewPair(int i, int j, const ViewClouds& view_j, const ViewTargets& target_i,
+                            const std::vector<Se2>& model, const RegistrationConfig& config);
+
+// Returns the edges of the alignments that hold (enough matched points, small RMSE), in the
+// order given, and their statistics in `stats` (when given).
+std::vector<PoseEdge> AcceptedEdges(const std::vector<PairAlignment>& alignments,
+                                    const RegistrationConfig& config, EdgeStats* stats);
+
+// Returns the graph edges: each selected pair (ViewPairs) is aligned coarse-then-fine from the
+// turntable model's relative pose; failed alignments are left out. Deterministic for any
+// thread count.
 std::vector<PoseEdge> RegisterViewPairs(const std::vector<ViewClouds>& views,
                                         const std::vector<double>& table_angles_rad,
                                         const RegistrationConfig& config, EdgeStats* stats);

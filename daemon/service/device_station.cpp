@@ -121,7 +121,7 @@ void DeviceStation::CloseDevices() {
 }
 
 Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms,
-                                       PosePreparer* preparer) {
+                                       std::unique_ptr<PosePreparer>* preparer) {
     capture_ms = 0.0;
     StationDevices* devices = nullptr;
     {
@@ -138,9 +138,15 @@ Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms
         if (ctx.progress) ctx.progress(JobProgress{"capture", pose, n});
     };
     if (preparer) {
-        const double unit = devices->camera->Intrinsics().depth_unit_m;
-        callbacks.on_pose = [preparer, unit](std::size_t index, const SessionPose& pose) {
-            preparer->Add(index, pose.frames, unit);
+        Session header;
+        header.camera = devices->camera->Intrinsics();
+        header.calibration = devices->station.calibration;
+        header.direction = devices->station.direction;
+        *preparer = std::make_unique<PosePreparer>(config_.measure, header, poses);
+        PosePreparer* p = preparer->get();
+        const double unit = header.camera.depth_unit_m;
+        callbacks.on_pose = [p, unit](std::size_t index, const SessionPose& pose) {
+            p->Add(index, pose.angle_deg, pose.frames, unit);
         };
     }
     const auto t_capture = std::chrono::steady_clock::now();
@@ -157,9 +163,9 @@ Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms
 
 JobOutput DeviceStation::Measure(const JobContext& ctx) {
     double capture_ms = 0.0;
-    PosePreparer preparer(config_.measure);
+    std::unique_ptr<PosePreparer> preparer;
     Result<Session> session = Capture(ctx, capture_ms, &preparer);
-    const int prepared_during_capture = preparer.Prepared();
+    const int streamed_during_capture = preparer ? preparer->Streamed() : 0;
     if (!session) {
         JobOutput out = FailedOutput(session.error().code, session.error().message);
         out.result.timing_ms["capture"] = capture_ms;
@@ -183,13 +189,14 @@ JobOutput DeviceStation::Measure(const JobContext& ctx) {
         return aborted;
     }
 
-    // Processing: the first stage ran pose by pose during the capture; the rest needs them all.
+    // Processing: the views and their alignments were made pose by pose during the capture;
+    // the pose graph, fusion and the fits need them all.
     if (ctx.progress) ctx.progress(JobProgress{"processing", poses, poses});
     const auto t_processing = std::chrono::steady_clock::now();
-    std::vector<PreparedPose> prepared = preparer.Finish(*session);
-    spdlog::info("measurement {}: {} of {} poses prepared during the capture", ctx.id,
-                 prepared_during_capture, poses);
-    Result<MeasureOutput> measured = MeasurePrepared(*session, std::move(prepared), config_.measure,
+    ViewStream& stream = preparer->Finish(*session);
+    spdlog::info("measurement {}: {} of {} poses streamed during the capture", ctx.id,
+                 streamed_during_capture, poses);
+    Result<MeasureOutput> measured = MeasureStreamed(*session, stream, config_.measure,
                                                      config_.method, SteadyClockMs());
     if (!measured) {
         JobOutput failed = FailedOutput(measured.error().code, measured.error().message);

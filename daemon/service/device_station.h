@@ -1,8 +1,9 @@
 #pragma once
 // DeviceStation: the Station of a configured turntable + depth camera (real or simulated) and the
 // measurement pipeline. A measurement captures a session pose by pose (progress "pose k of N");
-// each pose's first stage (PreparePose) runs on a PosePreparer while the table moves on, and the
-// rest of the recipe (MeasurePrepared), which needs every pose, runs after the last one.
+// each pose's share of the recipe (its first stage, its view and its alignments: PosePreparer)
+// runs while the table moves on, and the rest (MeasureStreamed), which needs every pose, after
+// the last one.
 
 #include <atomic>
 #include <filesystem>
@@ -51,7 +52,7 @@ private:
     // Captures one session with the open devices; progress is reported as "capture".
     // Captures a session; with a `preparer`, each pose is handed to it as soon as it is grabbed.
     Result<Session> Capture(const JobContext& ctx, double& capture_ms,
-                            PosePreparer* preparer = nullptr);
+                            std::unique_ptr<PosePreparer>* preparer = nullptr);
     // Puts the calibration stored in calibration_file in force when it is newer than the
     // config file's.
     void LoadStoredCalibration();

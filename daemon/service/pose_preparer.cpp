@@ -1,11 +1,15 @@
 #include "daemon/service/pose_preparer.h"
 
+#include <spdlog/spdlog.h>
+
 #include "pipeline/parallel_for.h"
 
 namespace boxd {
 
-PosePreparer::PosePreparer(MeasureConfig config)
-    : config_(std::move(config)), worker_([this] { Work(); }) {}
+PosePreparer::PosePreparer(MeasureConfig config, const Session& header, int poses)
+    : config_(std::move(config)),
+      stream_(header, poses, config_, SteadyClockMs()),
+      worker_([this] { Work(); }) {}
 
 PosePreparer::~PosePreparer() {
     {
@@ -16,10 +20,11 @@ PosePreparer::~PosePreparer() {
     if (worker_.joinable()) worker_.join();
 }
 
-void PosePreparer::Add(std::size_t index, std::vector<DepthImage> frames, double depth_unit_m) {
+void PosePreparer::Add(std::size_t index, double angle_deg, std::vector<DepthImage> frames,
+                       double depth_unit_m) {
     {
         std::lock_guard lock(mutex_);
-        queue_.push_back(Job{index, std::move(frames), depth_unit_m});
+        queue_.push_back(Job{index, angle_deg, std::move(frames), depth_unit_m});
     }
     wake_.notify_all();
 }
@@ -32,53 +37,66 @@ void PosePreparer::Work() {
         Job job = std::move(queue_.front());
         queue_.pop_front();
         lock.unlock();
-        PreparedPose pose = PreparePose(job.frames, job.depth_unit_m, config_);
+        waiting_.emplace(job.index, std::pair(job.angle_deg, PreparePose(job.frames,
+                                                                         job.depth_unit_m,
+                                                                         config_)));
+        // The stream takes the poses in order; a pose ahead of its turn waits for the others.
+        for (auto it = waiting_.find(static_cast<std::size_t>(stream_.Added()));
+             it != waiting_.end();
+             it = waiting_.find(static_cast<std::size_t>(stream_.Added()))) {
+            stream_.Add(it->second.first, std::move(it->second.second));
+            waiting_.erase(it);
+            streamed_.store(stream_.Added());
+        }
         lock.lock();
-        done_.emplace_back(job.index, std::move(pose));
     }
 }
 
-int PosePreparer::Prepared() const {
-    std::lock_guard lock(mutex_);
-    return static_cast<int>(done_.size());
-}
+int PosePreparer::Streamed() const { return streamed_.load(); }
 
-std::vector<PreparedPose> PosePreparer::Finish(const Session& session) {
-    // The worker finishes the pose in hand; what is still queued is prepared below on all
-    // threads (a source faster than the first stage, like a replay, leaves a backlog).
-    std::deque<Job> backlog;
+ViewStream& PosePreparer::Finish(const Session& session) {
+    // The worker finishes the pose in hand; the rest is prepared here on all threads (a source
+    // faster than the stream, like a replay, leaves a backlog).
     {
         std::lock_guard lock(mutex_);
         stop_ = true;
     }
     wake_.notify_all();
     if (worker_.joinable()) worker_.join();
+    std::deque<Job> backlog;
     backlog.swap(queue_);
     const std::size_t n = session.poses.size();
-    std::vector<PreparedPose> poses(n);
-    std::vector<char> have(n, 0);
-    for (auto& [index, pose] : done_) {
-        if (index < n && !have[index]) {
-            poses[index] = std::move(pose);
-            have[index] = 1;
-        }
+    bool same = static_cast<int>(n) == stream_.Planned();
+    for (int i = 0; same && i < stream_.Added(); ++i) {
+        same = stream_.AngleDeg(i) == session.poses[static_cast<std::size_t>(i)].angle_deg;
     }
-    done_.clear();
-    // The rest: the backlog's frames where they were handed over, else the session's own.
-    std::vector<const std::vector<DepthImage>*> frames(n, nullptr);
-    std::vector<double> units(n, session.camera.depth_unit_m);
+    if (!same) {
+        spdlog::warn("pose stream: the capture's poses differ from the plan; starting over");
+        stream_ = ViewStream(session, static_cast<int>(n), config_, SteadyClockMs());
+        waiting_.clear();
+        backlog.clear();
+    }
+    const std::size_t first = static_cast<std::size_t>(stream_.Added());
+    // What is left: prepared and waiting, queued (its frames), or never queued (the session's).
+    std::vector<PreparedPose> rest(n - std::min(n, first));
+    std::vector<const Job*> queued(rest.size(), nullptr);
     for (const Job& job : backlog) {
-        if (job.index < n && !have[job.index] && !frames[job.index]) {
-            frames[job.index] = &job.frames;
-            units[job.index] = job.depth_unit_m;
-        }
+        if (job.index >= first && job.index < n) queued[job.index - first] = &job;
     }
-    ParallelFor(static_cast<int>(n), config_.threads, [&](int k) {
-        const auto i = static_cast<std::size_t>(k);
-        if (have[i]) return;
-        poses[i] = PreparePose(frames[i] ? *frames[i] : session.poses[i].frames, units[i], config_);
+    ParallelFor(static_cast<int>(rest.size()), config_.threads, [&](int k) {
+        const std::size_t i = first + static_cast<std::size_t>(k);
+        if (auto it = waiting_.find(i); it != waiting_.end()) {
+            rest[static_cast<std::size_t>(k)] = std::move(it->second.second);
+        } else if (const Job* job = queued[static_cast<std::size_t>(k)]) {
+            rest[static_cast<std::size_t>(k)] = PreparePose(job->frames, job->depth_unit_m, config_);
+        } else {
+            rest[static_cast<std::size_t>(k)] =
+                PreparePose(session.poses[i].frames, session.camera.depth_unit_m, config_);
+        }
     });
-    return poses;
+    waiting_.clear();
+    stream_.AddAll(session, std::move(rest));
+    return stream_;
 }
 
 }  // namespace boxd

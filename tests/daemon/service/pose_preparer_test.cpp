@@ -1,50 +1,85 @@
-// PosePreparer: poses handed over during a capture come back prepared, in pose order, exactly as
-// PreparePose makes them; poses never handed over are prepared at the end.
+// PosePreparer: poses handed over during a capture, in any order, are prepared and streamed in
+// pose order; poses never handed over are added at the end. Whatever arrived when, the stream
+// ends up with the views and alignments of the whole session fed at once, and measures to the
+// same numbers.
 #include "daemon/service/pose_preparer.h"
 
 #include <gtest/gtest.h>
 
 #include "drivers/sim/synthetic_station.h"
+#include "pipeline/measure_pipeline.h"
 
 namespace boxd {
 namespace {
 
-TEST(PosePreparer, ReturnsEveryPosePreparedInOrder) {
+// Returns the session's measurement through a stream fed all at once.
+MeasurementResult AllAtOnce(const Session& session, const MeasureConfig& config) {
+    auto out = MeasurePrepared(session, PrepareSession(session, config), config,
+                               BoxMethod::kFootprint);
+    EXPECT_TRUE(out.ok());
+    return out->result;
+}
+
+TEST(PosePreparer, StreamsEveryPoseInOrderWhateverArrivedWhen) {
     SyntheticStationConfig c;
     c.seed = 9;
     auto session = RenderSyntheticSession(c, 6, 2);
     ASSERT_TRUE(session.ok());
     const MeasureConfig config;
-    PosePreparer preparer(config);
-    // Poses 4 and 1 arrive out of order; the others never arrive.
-    preparer.Add(4, session->poses[4].frames, session->camera.depth_unit_m);
-    preparer.Add(1, session->poses[1].frames, session->camera.depth_unit_m);
-    const std::vector<PreparedPose> got = preparer.Finish(*session);
-    ASSERT_EQ(got.size(), 6u);
-    for (std::size_t i = 0; i < got.size(); ++i) {
-        const PreparedPose want =
-            PreparePose(session->poses[i].frames, session->camera.depth_unit_m, config);
-        EXPECT_TRUE(got[i].error.empty()) << "pose " << i;
-        EXPECT_EQ(got[i].depth.z_m, want.depth.z_m) << "pose " << i;
+    PosePreparer preparer(config, *session, 6);
+    // Poses 0, 4, 1 arrive (4 before its turn); the others never do.
+    for (std::size_t i : {0, 4, 1}) {
+        preparer.Add(i, session->poses[i].angle_deg, session->poses[i].frames,
+                     session->camera.depth_unit_m);
     }
+    ViewStream& stream = preparer.Finish(*session);
+    EXPECT_TRUE(stream.Matches(*session));
+    auto streamed = MeasureStreamed(*session, stream, config, BoxMethod::kFootprint);
+    ASSERT_TRUE(streamed.ok());
+    const MeasurementResult want = AllAtOnce(*session, config);
+    ASSERT_EQ(streamed->result.status, MeasurementStatus::kOk);
+    ASSERT_EQ(want.status, MeasurementStatus::kOk);
+    EXPECT_EQ(streamed->result.dimensions->length_m, want.dimensions->length_m);
+    EXPECT_EQ(streamed->result.dimensions->width_m, want.dimensions->width_m);
+    EXPECT_EQ(streamed->result.dimensions->height_m, want.dimensions->height_m);
+    EXPECT_EQ(streamed->result.quality.registration_rmse_m, want.quality.registration_rmse_m);
+}
+
+TEST(PosePreparer, StartsOverWhenTheCaptureIsNotThePlan) {
+    SyntheticStationConfig c;
+    c.seed = 10;
+    auto session = RenderSyntheticSession(c, 6, 2);
+    ASSERT_TRUE(session.ok());
+    const MeasureConfig config;
+    PosePreparer preparer(config, *session, 6);
+    // Pose 1 was streamed at another angle than the session records.
+    preparer.Add(0, session->poses[0].angle_deg, session->poses[0].frames,
+                 session->camera.depth_unit_m);
+    preparer.Add(1, session->poses[1].angle_deg + 7.0, session->poses[1].frames,
+                 session->camera.depth_unit_m);
+    ViewStream& stream = preparer.Finish(*session);
+    EXPECT_TRUE(stream.Matches(*session));
+    auto streamed = MeasureStreamed(*session, stream, config, BoxMethod::kFootprint);
+    ASSERT_TRUE(streamed.ok());
+    EXPECT_EQ(streamed->result.dimensions->length_m,
+              AllAtOnce(*session, config).dimensions->length_m);
 }
 
 TEST(PosePreparer, StopsCleanlyWithWorkQueued) {
     SyntheticStationConfig c;
     auto session = RenderSyntheticSession(c, 2, 1);
     ASSERT_TRUE(session.ok());
-    auto preparer = std::make_unique<PosePreparer>(MeasureConfig{});
+    auto preparer = std::make_unique<PosePreparer>(MeasureConfig{}, *session, 2);
     for (int k = 0; k < 20; ++k) {
-        preparer->Add(static_cast<std::size_t>(k % 2), session->poses[0].frames,
+        preparer->Add(static_cast<std::size_t>(k % 2), 0.0, session->poses[0].frames,
                       session->camera.depth_unit_m);
     }
     preparer.reset();  // an aborted measurement: must neither hang nor crash
-    // Nothing handed over: Finish prepares every pose itself.
-    PosePreparer idle{MeasureConfig{}};
-    const std::vector<PreparedPose> got = idle.Finish(*session);
-    ASSERT_EQ(got.size(), 2u);
-    EXPECT_TRUE(got[1].error.empty());
-    EXPECT_GT(ValidFraction(got[1].depth), 0.5);
+    // Nothing handed over: Finish adds every pose itself.
+    PosePreparer idle{MeasureConfig{}, *session, 2};
+    ViewStream& stream = idle.Finish(*session);
+    EXPECT_EQ(stream.Added(), 2);
+    EXPECT_TRUE(stream.Matches(*session));
 }
 
 }  // namespace

@@ -143,10 +143,11 @@ TEST(ServeSimStation, MeasuresTheSimulatedBoxAndServesItAcrossKill9) {
         EXPECT_NEAR(d["height_m"].get<double>(), true_h, 0.015) << first.dump(2);
         EXPECT_EQ(first["quality"]["poses"], sim["capture"]["poses"].as<int>());
         EXPECT_GT(first["timing_ms"]["capture"].get<double>(), 0.0);
-        // The first stage ran pose by pose while the table moved on: the log says how many
-        // poses were ready when the capture ended (pose 0 is, long before the last one).
+        // The views and their alignments were made pose by pose while the table moved on: the
+        // log says how many poses were streamed when the capture ended (pose 0 was, long
+        // before the last one).
         const std::string log = ReadText(dir / "serve1.log");
-        const auto at = log.find(" poses prepared during the capture");
+        const auto at = log.find(" poses streamed during the capture");
         ASSERT_NE(at, std::string::npos) << log;
         const auto of = log.rfind(" of ", at);
         const int early = std::stoi(log.substr(log.rfind(' ', of - 1) + 1));

@@ -1,0 +1,224 @@
+#include "pipeline/view_stream.h"
+
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "pipeline/parallel_for.h"
+
+namespace boxd {
+
+namespace {
+
+// Table candidates kept per pose: thousands are plenty for a plane, and a 360-pose session
+// must not hold every pose's tens of thousands.
+constexpr std::size_t kCandidatesPerPose = 4000;
+
+std::vector<Eigen::Vector3d> EvenSubsample(std::vector<Eigen::Vector3d> pts, std::size_t most) {
+    if (pts.size() <= most) return pts;
+    const std::size_t step = (pts.size() + most - 1) / most;
+    std::vector<Eigen::Vector3d> out;
+    for (std::size_t i = 0; i < pts.size(); i += step) out.push_back(pts[i]);
+    return out;
+}
+
+}  // namespace
+
+ViewStream::ViewStream(const Session& header, int poses, MeasureConfig config, MonotonicMs clock)
+    : planned_(std::max(0, poses)), config_(std::move(config)), clock_(std::move(clock)) {
+    header_.camera = header.camera;
+    header_.calibration = header.calibration;
+    header_.direction = header.direction;
+    views_.views.resize(static_cast<std::size_t>(planned_));
+    views_.clouds.resize(static_cast<std::size_t>(planned_));
+    targets_.resize(static_cast<std::size_t>(planned_));
+}
+
+bool ViewStream::Matches(const Session& session) const {
+    if (static_cast<int>(session.poses.size()) != planned_ || Added() != planned_) return false;
+    for (std::size_t i = 0; i < session.poses.size(); ++i) {
+        if (session.poses[i].angle_deg != angles_deg_[i]) return false;
+    }
+    return session.direction == header_.direction;
+}
+
+bool ViewStream::Accept(std::size_t k, PreparedPose pose) {
+    auto depth = UsableDepth(std::move(pose), k, config_.refusal);
+    if (!depth) {
+        unusable_ = depth.error();
+        return false;
+    }
+    candidates_[k] = EvenSubsample(
+        TableCandidates(*depth, header_.camera, header_.calibration, config_.table_plane),
+        kCandidatesPerPose);
+    pending_.push_back(std::move(*depth));
+    return true;
+}
+
+void ViewStream::TryTable() {
+    if (provisional_) return;
+    std::vector<Eigen::Vector3d> pooled;
+    for (const auto& c : candidates_) pooled.insert(pooled.end(), c.begin(), c.end());
+    auto fit = FitTableCandidates(pooled, header_.calibration, config_.table_plane);
+    if (fit) {
+        provisional_ = *fit;
+        table_error_.reset();
+    } else {
+        table_error_ = fit.error();
+    }
+}
+
+void ViewStream::SegmentInto(std::size_t k, const DepthMap& depth) {
+    SegmentedView& view = views_.views[k];
+    view = SegmentView(depth, header_.camera, header_.calibration, provisional_->camera_to_table,
+                       config_.segmentation);
+    views_.clouds[k] =
+        BuildRegistrationClouds(view.points, config_.registration.coarse_cloud,
+                                config_.registration.fine_cloud,
+                                provisional_->camera_to_table.translation().cast<float>());
+    targets_[k] = std::make_unique<ViewTargets>(views_.clouds[k], config_.registration);
+    // A single view keeps every pixel: with no other view to fuse, its faces' edges are all
+    // the footprint there is, and the fusion stride would cut them short by up to 3 pixels.
+    if (planned_ > 1) view.points = Points{};
+}
+
+std::vector<int> ViewStream::EarlierPairs(int j) const {
+    // A pair's views are at most max_pose_step apart, directly or across the end of the turn
+    // (the first views with the last ones): the candidates are a few, whatever the count.
+    const int step = config_.registration.max_pose_step;
+    std::vector<int> out;
+    for (int i = 0; i < j; ++i) {
+        if (i >= step && i < j - step) i = j - step;  // skip the views between
+        const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
+        if (IsViewPair(i, j, planned_, angles_rad_[ui], angles_rad_[uj], config_.registration)) {
+            out.push_back(i);
+        }
+    }
+    return out;
+}
+
+void ViewStream::Add(double angle_deg, PreparedPose pose) {
+    AddPoses({angle_deg}, {}, std::vector<PreparedPose>{}, &pose);
+}
+
+void ViewStream::AddAll(const Session& session, std::vector<PreparedPose> poses) {
+    std::vector<double> degrees;
+    for (std::size_t i = static_cast<std::size_t>(Added()); i < session.poses.size(); ++i) {
+        degrees.push_back(session.poses[i].angle_deg);
+    }
+    degrees.resize(std::min(degrees.size(), poses.size()));
+    AddPoses(degrees, session.PoseAnglesRad(), std::move(poses), nullptr);
+}
+
+void ViewStream::AddPoses(const std::vector<double>& degrees, const std::vector<double>& session_rad,
+                          std::vector<PreparedPose> poses, PreparedPose* one) {
+    const double t0 = Now();
+    const int first = Added();
+    const int n = std::min(planned_ - first, static_cast<int>(degrees.size()));
+    if (n <= 0) return;
+    candidates_.resize(static_cast<std::size_t>(planned_));
+    std::vector<char> usable(static_cast<std::size_t>(n), 1);
+    std::vector<PreparedPose*> in(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) {
+        const auto k = static_cast<std::size_t>(first + i);
+        angles_deg_.push_back(degrees[static_cast<std::size_t>(i)]);
+        if (k < session_rad.size()) {
+            angles_rad_.push_back(session_rad[k]);
+        } else {
+            Session one_pose = header_;
+            one_pose.poses.resize(1);
+            one_pose.poses[0].angle_deg = degrees[static_cast<std::size_t>(i)];
+            angles_rad_.push_back(one_pose.PoseAngleRad(0));
+        }
+        in[static_cast<std::size_t>(i)] = one ? one : &poses[static_cast<std::size_t>(i)];
+    }
+    // Each pose in order: checked, its table candidates, and the provisional table once they
+    // locate it — the same sequence whether the poses come one by one or all at once.
+    for (int i = 0; i < n && !Blocked(); ++i) {
+        if (!Accept(static_cast<std::size_t>(first + i), std::move(*in[static_cast<std::size_t>(i)])))
+            break;
+        TryTable();
+    }
+    if (Blocked() || !provisional_) {
+        segment_ms_ += (Now() - t0);
+        return;
+    }
+    // The views waiting for the table, then their alignments with the views before them.
+    const int from = segmented_;
+    const int count = static_cast<int>(pending_.size());
+    ParallelFor(count, config_.threads, [&](int i) {
+        SegmentInto(static_cast<std::size_t>(from + i), pending_[static_cast<std::size_t>(i)]);
+    });
+    pending_.clear();
+    segmented_ = from + count;
+    segment_ms_ += (Now() - t0);
+    const double t1 = Now();
+    std::vector<std::pair<int, int>> pairs;
+    for (int j = from; j < segmented_; ++j) {
+        for (int i : EarlierPairs(j)) pairs.emplace_back(i, j);
+    }
+    const std::vector<Se2> model = TurntablePoses(angles_rad_);
+    std::vector<PairAlignment> aligned(pairs.size());
+    ParallelFor(static_cast<int>(pairs.size()), config_.threads, [&](int e) {
+        const auto [i, j] = pairs[static_cast<std::size_t>(e)];
+        aligned[static_cast<std::size_t>(e)] =
+            AlignViewPair(i, j, views_.clouds[static_cast<std::size_t>(j)],
+                          *targets_[static_cast<std::size_t>(i)], model, config_.registration);
+    });
+    for (PairAlignment& a : aligned) alignments_.push_back(std::move(a));
+    align_ms_ += (Now() - t1);
+}
+
+std::optional<MeasurementReason> ViewStream::Complete() {
+    if (planned_ == 0) {
+        return MeasurementReason{ErrorCode::kInsufficientData, "the session has no poses"};
+    }
+    if (unusable_) return unusable_;
+    if (!provisional_) {
+        if (table_error_) return table_error_;
+        return MeasurementReason{ErrorCode::kInsufficientData, "no pose locates the table"};
+    }
+    if (!completed_) {
+        completed_ = true;
+        // The plane of every pose's table top, and the views moved from the provisional frame
+        // into it.
+        std::vector<Eigen::Vector3d> pooled;
+        for (const auto& c : candidates_) pooled.insert(pooled.end(), c.begin(), c.end());
+        auto all = FitTableCandidates(pooled, header_.calibration, config_.table_plane);
+        if (!all) {
+            table_error_ = all.error();
+        } else {
+            table_ = *all;
+            const Eigen::Isometry3f move =
+                (table_.camera_to_table * provisional_->camera_to_table.inverse()).cast<float>();
+            spdlog::debug("table: refitted to every pose, the views move by {:.3f} mm and {:.4f} deg",
+                          move.translation().norm() * 1e3,
+                          Eigen::AngleAxisf(move.linear()).angle() * 180.0 / M_PI);
+            for (SegmentedView& v : views_.views) {
+                for (Eigen::Vector3f& p : v.fusion_points) p = move * p;
+                for (Eigen::Vector3f& p : v.points) p = move * p;
+            }
+            table_error_.reset();
+        }
+        candidates_.clear();
+        views_.fusion_points = 0;
+        for (const SegmentedView& v : views_.views) {
+            views_.fusion_points += static_cast<long>(v.fusion_points.size());
+        }
+    }
+    if (table_error_) return table_error_;
+    return CheckObjectViews(views_, config_.refusal);
+}
+
+std::vector<PoseEdge> ViewStream::Edges(EdgeStats* stats) const {
+    std::vector<PairAlignment> sorted = alignments_;
+    std::sort(sorted.begin(), sorted.end(), [](const PairAlignment& a, const PairAlignment& b) {
+        return std::pair(a.edge.from, a.edge.to) < std::pair(b.edge.from, b.edge.to);
+    });
+    return AcceptedEdges(sorted, config_.registration, stats);
+}
+
+}  // namespace boxd

@@ -1,0 +1,97 @@
+#pragma once
+// Stages 2 to 4a pose by pose, as a capture delivers them: the table frame from the first pose,
+// then each view's object points and registration clouds, and its ICP alignments with the views
+// before it (its neighbours, and at the end of the turn the loop closures with the first ones).
+// A capture runs them while the table turns, so that after its last pose only that pose's own
+// share, the pose graph, fusion and the fits remain. MeasurePrepared feeds a whole session at
+// once (views and alignments in parallel); either way the views and edges are the same.
+//
+// The views are cut in the table frame of the first pose's table top (every pose sees the same
+// plane, the table turns in it, and one pose holds thousands of table readings), known before
+// the second pose arrives; a pose whose table is hidden waits for the next ones. Once every pose
+// is in, the plane is refitted to the table top of all of them, and the views' points move by
+// the small correction (tenths of a millimetre) before they are fused: heights are measured
+// from the plane every pose saw.
+
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "pipeline/measure_config.h"
+#include "pipeline/object_views.h"
+#include "pipeline/prepare_pose.h"
+#include "pipeline/refusal.h"
+#include "pipeline/session.h"
+#include "pipeline/stage_laps.h"
+#include "pipeline/table_plane.h"
+#include "pipeline/view_registration.h"
+
+namespace boxd {
+
+class ViewStream {
+public:
+    // `header`: the session's camera, calibration and turntable direction (its poses are not
+    // read); `poses`: how many poses the session will have (the loop closures pair its last
+    // poses with its first ones).
+    // `clock` times the stages (their laps stay zero without one).
+    ViewStream(const Session& header, int poses, MeasureConfig config, MonotonicMs clock = {});
+
+    // Adds the next pose (index Added()), commanded `angle_deg` from pose 0, and does its share
+    // of the stages. Poses beyond the announced count are ignored.
+    void Add(double angle_deg, PreparedPose pose);
+
+    // Adds every pose of `session` (prepared in pose order) to an empty stream, each stage on
+    // config.threads threads.
+    void AddAll(const Session& session, std::vector<PreparedPose> poses);
+
+    int Added() const { return static_cast<int>(angles_deg_.size()); }
+    int Planned() const { return planned_; }
+    double AngleDeg(int i) const { return angles_deg_.at(static_cast<std::size_t>(i)); }
+    // Whether the stream was fed exactly the poses (count and angles) of `session`.
+    bool Matches(const Session& session) const;
+
+    // Once every pose is added: refits the table to all poses and moves the views into that
+    // frame (once), and returns the first refusal in the stages' order (an unusable pose, then
+    // the table, then the views' checks).
+    std::optional<MeasurementReason> Complete();
+    // After Complete: the table fit, the views, the accepted edges with their statistics.
+    const TablePlaneFit& table() const { return table_; }
+    ObjectViews& views() { return views_; }
+    std::vector<PoseEdge> Edges(EdgeStats* stats) const;
+    // Time spent in Add / AddAll: the table and the views, and the alignments.
+    double segment_ms() const { return segment_ms_; }
+    double align_ms() const { return align_ms_; }
+
+private:
+    // Takes pose k (its depth checked, its table candidates kept); false when it is unusable.
+    bool Accept(std::size_t k, PreparedPose pose);
+    // Add and AddAll: `degrees` of the new poses, the session's model angles when known, the
+    // poses (or `one`, a single pose).
+    void AddPoses(const std::vector<double>& degrees, const std::vector<double>& session_rad,
+                  std::vector<PreparedPose> poses, PreparedPose* one);
+    void TryTable();  // the provisional table frame from the candidates so far
+    void SegmentInto(std::size_t k, const DepthMap& depth);
+    std::vector<int> EarlierPairs(int j) const;  // the views i < j paired with view j
+    bool Blocked() const { return unusable_.has_value(); }
+    double Now() const { return clock_ ? clock_() : 0.0; }
+
+    Session header_;
+    int planned_;
+    MeasureConfig config_;
+    std::vector<double> angles_deg_, angles_rad_;
+    std::optional<MeasurementReason> unusable_, table_error_;
+    std::vector<std::vector<Eigen::Vector3d>> candidates_;  // per pose, subsampled
+    std::optional<TablePlaneFit> provisional_;
+    TablePlaneFit table_;
+    std::vector<DepthMap> pending_;  // accepted depths not yet cut into views, from `segmented_`
+    int segmented_ = 0;
+    bool completed_ = false;
+    ObjectViews views_;
+    std::vector<std::unique_ptr<ViewTargets>> targets_;
+    std::vector<PairAlignment> alignments_;  // in the order they were made
+    MonotonicMs clock_;
+    double segment_ms_ = 0.0, align_ms_ = 0.0;
+};
+
+}  // namespace boxd
