@@ -13,9 +13,11 @@ namespace boxd {
 
 namespace {
 
-// Table candidates kept per pose: thousands are plenty for a plane, and a 360-pose session
-// must not hold every pose's tens of thousands.
+// Table candidates kept per pose: thousands are plenty for a plane, and the refit over all poses
+// stays within a fixed total, so that a 360-pose session neither holds nor refits every pose's
+// tens of thousands.
 constexpr std::size_t kCandidatesPerPose = 4000;
+constexpr std::size_t kCandidatesInAll = 100000;
 
 std::vector<Eigen::Vector3d> EvenSubsample(std::vector<Eigen::Vector3d> pts, std::size_t most) {
     if (pts.size() <= most) return pts;
@@ -51,9 +53,10 @@ bool ViewStream::Accept(std::size_t k, PreparedPose pose) {
         unusable_ = depth.error();
         return false;
     }
+    const std::size_t share = std::max<std::size_t>(
+        100, std::min(kCandidatesPerPose, kCandidatesInAll / static_cast<std::size_t>(planned_)));
     candidates_[k] = EvenSubsample(
-        TableCandidates(*depth, header_.camera, header_.calibration, config_.table_plane),
-        kCandidatesPerPose);
+        TableCandidates(*depth, header_.camera, header_.calibration, config_.table_plane), share);
     pending_.push_back(std::move(*depth));
     return true;
 }
@@ -169,6 +172,10 @@ void ViewStream::AddPoses(const std::vector<double>& degrees, const std::vector<
                           *targets_[static_cast<std::size_t>(i)], model, config_.registration);
     });
     for (PairAlignment& a : aligned) alignments_.push_back(std::move(a));
+    // A view's search index is done with once no later view can pair with it: the ones more
+    // than max_pose_step back, except the first few, which close the loop with the last ones.
+    const int step = config_.registration.max_pose_step;
+    for (int i = step; i < segmented_ - step; ++i) targets_[static_cast<std::size_t>(i)].reset();
     align_ms_ += (Now() - t1);
 }
 
