@@ -116,6 +116,7 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     // The subsample of the surface above the table that the fill, the support function and a
     // grazing top's height all read.
     const envelope::Surface surface = envelope::SurfaceAbove(cloud, config);
+    double face_excess = 0.0;  // the face fit's, when it was tried: a deciding figure either way
     if (box) {
         const BoxFit& fit = *box;
         const std::array<envelope::FaceResult, 5> faces =
@@ -173,6 +174,7 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
             faces[2].offset_se_m * 1e3, faces[3].offset_se_m * 1e3, faces[4].offset_se_m * 1e3,
             c.fill, c.top_cover);
         if (c.cuboid) return c;
+        face_excess = c.max_relative_excess;
     }
     // No flat faces at right angles: the support function of the surface.
     // The outer layer of a cell column is the sensor's noise deep: the noise of the table top
@@ -181,6 +183,7 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     auto c = envelope::EnvelopeCuboid(surface, sigma, config);
     if (!c) return c;
     c->cuboid = false;
+    c->max_relative_excess = face_excess;
     c->fill = FillRatio(surface, *c, config);
     c->top_cover = TopCover(surface, c->height_m, config);
     return c;
