@@ -17,12 +17,18 @@ struct Support {
 };
 
 // The support along (cos φ, sin φ) read from cells of `cell_along` x `cell_height`.
-Support SupportAtScale(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector2d& u,
-                       double sigma, double radius, double top, double cell_along,
-                       double cell_height, const EnvelopeConfig& config) {
+// The outer layers in direction u (front) and -u (back), over cells of (across, up).
+struct Layers {
+    CellGrid<LayerCell> front, back;
+};
+
+Layers BuildLayers(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector2d& u,
+                   double sigma, double radius, double top, double cell_along, double cell_height,
+                   const EnvelopeConfig& config) {
     const Eigen::Vector2d v(-u.y(), u.x());
-    CellGrid<LayerCell> front(-radius, radius, 0.0, top, cell_along, cell_height);
-    CellGrid<LayerCell> back = front;
+    Layers out{CellGrid<LayerCell>(-radius, radius, 0.0, top, cell_along, cell_height),
+               CellGrid<LayerCell>(-radius, radius, 0.0, top, cell_along, cell_height)};
+    CellGrid<LayerCell>& front = out.front;
     std::vector<double> max_s(front.cells.size(), -INFINITY), min_s(front.cells.size(), INFINITY);
     auto index = [&front](const LayerCell* c) {
         return static_cast<std::size_t>(c - front.cells.data());
@@ -44,38 +50,60 @@ Support SupportAtScale(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vec
         const std::size_t k = index(c);
         const double s = u.dot(q), t = v.dot(q);
         if (s >= max_s[k] - layer) c->Add3(t, p.z(), s);
-        if (s <= min_s[k] + layer) back.cells[k].Add3(-t, p.z(), -s);
+        if (s <= min_s[k] + layer) out.back.cells[k].Add3(-t, p.z(), -s);
     }
-    Support out;
-    int judged = 0;
-    const double extent = std::max(cell_along, cell_height);
-    out.forward = LargestBound(front.cells, config, sigma, extent, &out.se_forward, &judged);
-    out.backward = LargestBound(back.cells, config, sigma, extent, &out.se_backward, &judged);
     return out;
 }
 
-// The support at the configured cells and at cells twice as large each way. Where the cloud is
-// sparse (a large object, a face seen obliquely, the subsample) a face's small cells may hold
-// too few readings to be judged at all, and the support would silently fall back to whatever
-// is dense inside it (a thin panel's two sides, millimetres apart, share their cells) —
-// a confident footprint far too small. The larger cells hold four times the readings; each
-// side takes the farther of the two reaches.
+// Leaves out of `coarse` (cells twice the size each way, on the same origin) every cell that
+// holds a judged cell of `fine`: there the small cells have had their say.
+void KeepGapsOnly(const CellGrid<LayerCell>& fine, CellGrid<LayerCell>& coarse,
+                  const EnvelopeConfig& config) {
+    for (int j = 0; j < fine.nb; ++j) {
+        for (int i = 0; i < fine.na; ++i) {
+            const LayerCell& f = fine.cells[static_cast<std::size_t>(j) * fine.na + i];
+            if (f.n < config.min_cell_points) continue;
+            const int ci = i / 2, cj = j / 2;
+            if (ci >= coarse.na || cj >= coarse.nb) continue;
+            coarse.cells[static_cast<std::size_t>(cj) * coarse.na + ci] = LayerCell{};
+        }
+    }
+}
+
+// The support at the configured cells and, where they judge nothing, at cells twice as large
+// each way. Where the cloud is sparse (a large object, a face seen obliquely, the subsample) a
+// face's small cells may hold too few readings to be judged at all, and the support would
+// silently fall back to whatever is dense inside it (a thin panel's two sides, millimetres
+// apart, share their cells) — a confident footprint far too small. The larger cells hold four
+// times the readings, and fill those gaps only, as faces: where a small cell is judged its
+// reading stands, and a gap's larger cell is read at its mean (a larger cell's layer mixes more
+// surface, and on a noisy cloud would pass the ends of the faces that meet in it for walls
+// reaching millimetres farther).
 Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double sigma,
                      double radius, double top, const EnvelopeConfig& config) {
     const Eigen::Vector2d u(std::cos(phi), std::sin(phi));
-    Support fine = SupportAtScale(pts, u, sigma, radius, top, config.cell_along_m,
-                                  config.cell_height_m, config);
-    const Support coarse = SupportAtScale(pts, u, sigma, radius, top, 2.0 * config.cell_along_m,
-                                          2.0 * config.cell_height_m, config);
-    if (coarse.forward > fine.forward) {
-        fine.forward = coarse.forward;
-        fine.se_forward = coarse.se_forward;
+    const double along = config.cell_along_m, height = config.cell_height_m;
+    const Layers fine = BuildLayers(pts, u, sigma, radius, top, along, height, config);
+    Layers coarse = BuildLayers(pts, u, sigma, radius, top, 2.0 * along, 2.0 * height, config);
+    KeepGapsOnly(fine.front, coarse.front, config);
+    KeepGapsOnly(fine.back, coarse.back, config);
+    Support out;
+    int judged = 0;
+    auto farther = [&](const Layers& layers, double extent, bool forward, bool walls) {
+        double se = 0.0;
+        const auto& cells = forward ? layers.front.cells : layers.back.cells;
+        const double bound = LargestBound(cells, config, sigma, extent, &se, &judged, walls);
+        double& best = forward ? out.forward : out.backward;
+        if (bound > best) {
+            best = bound;
+            (forward ? out.se_forward : out.se_backward) = se;
+        }
+    };
+    for (bool forward : {true, false}) {
+        farther(fine, std::max(along, height), forward, true);
+        farther(coarse, 2.0 * std::max(along, height), forward, false);
     }
-    if (coarse.backward > fine.backward) {
-        fine.backward = coarse.backward;
-        fine.se_backward = coarse.se_backward;
-    }
-    return fine;
+    return out;
 }
 
 }  // namespace

@@ -25,7 +25,8 @@ double LayerCell::Facing(double* off_plane) const {
 double MedianOfLargest(int m) { return UpperNormalQuantile(1.0 - std::pow(0.5, 1.0 / m)); }
 
 double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
-                    double noise_sigma, double cell_extent_m, double* se, int* judged) {
+                    double noise_sigma, double cell_extent_m, double* se, int* judged,
+                    bool walls) {
     // A cell's outer layer is one of three things; its own 3-D scatter says which.
     //  - A surface facing the direction (its normal within 60 degrees of it): the mean is the
     //    surface. Tilted by θ, it spreads over the cell's extent e by e·tan θ (at most the
@@ -57,7 +58,7 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
                 std::min(cell_extent_m * std::sqrt(1.0 - cos_t * cos_t) / cos_t, layer);
             return {c.Mean(), spread > noise_sigma ? spread / std::sqrt(12.0) : 0.0};
         }
-        if (var - noise_var <= wander) return {c.Mean(), 0.0};
+        if (!walls || var - noise_var <= wander) return {c.Mean(), 0.0};
         if (off_plane > noise_var + wander) return {c.Mean(), layer / std::sqrt(12.0)};
         return {c.Mean() + std::sqrt(3.0 * (var - noise_var)), 0.0};
     };

@@ -61,10 +61,12 @@ double MedianOfLargest(int m);
 // median of the largest of that many noise draws — noise alone then moves the estimate neither
 // out nor in. A flat face has many such cells (a large correction), a tube's tangent few.
 // `cell_extent_m` is the cells' larger side; `se` receives the chosen cell's standard error (with
-// a sloped surface's spread), `judged` the number of cells with enough points. Returns -inf when
-// no cell is judged.
+// a sloped surface's spread), `judged` the number of cells with enough points. Without `walls`
+// every cell reads as a surface facing the direction (its mean), none as a wall's end. Returns
+// -inf when no cell is judged.
 double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
-                    double noise_sigma, double cell_extent_m, double* se, int* judged);
+                    double noise_sigma, double cell_extent_m, double* se, int* judged,
+                    bool walls = true);
 
 // A dense grid of cells over a rectangle of the (a, b) plane.
 template <typename Cell>
