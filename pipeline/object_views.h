@@ -19,6 +19,17 @@ struct ObjectViews {
     long fusion_points = 0;                  // over all views
 };
 
+// Returns one view of the averaged `depth`: its object points and its registration clouds
+// (normals facing the camera, at `camera_to_table`'s origin). Unless `keep_points`, the
+// full-density points are dropped once the clouds are built (only a single view needs them).
+void SegmentObjectView(const DepthMap& depth, const CameraIntrinsics& camera,
+                       const StationCalibration& calibration,
+                       const Eigen::Isometry3d& camera_to_table,
+                       const SegmentationConfig& segmentation,
+                       const RegistrationCloudConfig& coarse_cloud,
+                       const RegistrationCloudConfig& fine_cloud, bool keep_points,
+                       SegmentedView* view, RegistrationClouds* clouds);
+
 // Returns the object views of the averaged `depths` (one per pose) on `threads` threads.
 ObjectViews SegmentObjectViews(const std::vector<DepthMap>& depths, const CameraIntrinsics& camera,
                                const StationCalibration& calibration,

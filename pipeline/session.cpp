@@ -5,9 +5,13 @@
 
 namespace boxd {
 
-double Session::PoseAngleRad(std::size_t i) const {
-    const double rad = poses.at(i).angle_deg * M_PI / 180.0;
+double TurntableAngleRad(double angle_deg, TurntableDirection direction) {
+    const double rad = angle_deg * M_PI / 180.0;
     return direction == TurntableDirection::kCcw ? rad : -rad;
+}
+
+double Session::PoseAngleRad(std::size_t i) const {
+    return TurntableAngleRad(poses.at(i).angle_deg, direction);
 }
 
 std::string SessionFramePath(std::size_t pose, std::size_t frame) {

@@ -29,6 +29,10 @@ struct SessionPose {
     std::vector<DepthImage> frames;        // raw frames, same order as frame_paths
 };
 
+// Returns a commanded turntable angle in radians, signed so that positive is a counter-clockwise
+// turn about the table axis (a clockwise table's angles are negated).
+double TurntableAngleRad(double angle_deg, TurntableDirection direction);
+
 struct Session {
     std::string source = "synthetic";
     CameraIntrinsics camera;

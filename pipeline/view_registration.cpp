@@ -37,6 +37,11 @@ std::vector<Se2> TurntablePoses(const std::vector<double>& table_angles_rad) {
     return poses;
 }
 
+namespace {
+
+// Whether views i < j of a session of `poses` views, at turntable angles `angle_i_rad` and
+// `angle_j_rad`, are aligned: cyclic index distance at most max_pose_step, angles at most
+// max_pair_angle_deg apart.
 bool IsViewPair(int i, int j, int poses, double angle_i_rad, double angle_j_rad,
                 const RegistrationConfig& config) {
     const int d = j - i;
@@ -46,23 +51,30 @@ bool IsViewPair(int i, int j, int poses, double angle_i_rad, double angle_j_rad,
     return diff * 180.0 / M_PI <= config.max_pair_angle_deg;
 }
 
+}  // namespace
+
+std::vector<int> PairedEarlierViews(int j, int poses, const std::vector<double>& table_angles_rad,
+                                    const RegistrationConfig& config) {
+    // A pair's views are at most max_pose_step apart, directly or across the end of the turn
+    // (the first views with the last ones): the candidates are a few, whatever the count.
+    const int step = config.max_pose_step;
+    std::vector<int> out;
+    for (int i = 0; i < j; ++i) {
+        if (i >= step && i < j - step) i = j - step;  // skip the views between
+        const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
+        if (IsViewPair(i, j, poses, table_angles_rad[ui], table_angles_rad[uj], config)) {
+            out.push_back(i);
+        }
+    }
+    return out;
+}
+
 std::vector<std::pair<int, int>> ViewPairs(const std::vector<double>& table_angles_rad,
                                            const RegistrationConfig& config) {
     const int n = static_cast<int>(table_angles_rad.size());
     std::vector<std::pair<int, int>> pairs;
-    auto consider = [&](int i, int j) {
-        const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
-        if (IsViewPair(i, j, n, table_angles_rad[ui], table_angles_rad[uj], config)) {
-            pairs.emplace_back(i, j);
-        }
-    };
-    // Forward steps, and the steps that close the loop from the last views to the first ones
-    // (those a forward step of a short session has not already counted).
-    for (int i = 0; i < n; ++i) {
-        for (int d = 1; d <= config.max_pose_step; ++d) {
-            if (i + d < n) consider(i, i + d);
-            if (n - d > config.max_pose_step && i + n - d < n) consider(i, i + n - d);
-        }
+    for (int j = 1; j < n; ++j) {
+        for (int i : PairedEarlierViews(j, n, table_angles_rad, config)) pairs.emplace_back(i, j);
     }
     std::sort(pairs.begin(), pairs.end());
     return pairs;

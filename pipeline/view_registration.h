@@ -49,13 +49,13 @@ struct EdgeStats {
 // which maps view k's points back into the frame of pose 0.
 std::vector<Se2> TurntablePoses(const std::vector<double>& table_angles_rad);
 
-// Whether views i < j of a session of `poses` views, at turntable angles `angle_i_rad` and
-// `angle_j_rad`, are aligned: cyclic index distance at most max_pose_step, angles at most
-// max_pair_angle_deg apart.
-bool IsViewPair(int i, int j, int poses, double angle_i_rad, double angle_j_rad,
-                const RegistrationConfig& config);
+// Returns the views i < j that view j of a session of `poses` views is aligned with: cyclic index
+// distance at most max_pose_step, turntable angles at most max_pair_angle_deg apart. Reads only
+// the angles of views 0..j, so a capture can ask as soon as view j arrives.
+std::vector<int> PairedEarlierViews(int j, int poses, const std::vector<double>& table_angles_rad,
+                                    const RegistrationConfig& config);
 
-// Returns every pair (i, j), i < j, that IsViewPair, sorted.
+// Returns every pair (i, j), i < j, of PairedEarlierViews, sorted.
 std::vector<std::pair<int, int>> ViewPairs(const std::vector<double>& table_angles_rad,
                                            const RegistrationConfig& config);
 

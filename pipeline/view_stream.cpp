@@ -39,12 +39,17 @@ ViewStream::ViewStream(const Session& header, int poses, MeasureConfig config, M
     targets_.resize(static_cast<std::size_t>(planned_));
 }
 
-bool ViewStream::Matches(const Session& session) const {
-    if (static_cast<int>(session.poses.size()) != planned_ || Added() != planned_) return false;
-    for (std::size_t i = 0; i < session.poses.size(); ++i) {
+bool ViewStream::Follows(const Session& session) const {
+    if (static_cast<int>(session.poses.size()) != planned_) return false;
+    if (session.direction != header_.direction) return false;
+    for (std::size_t i = 0; i < angles_deg_.size(); ++i) {
         if (session.poses[i].angle_deg != angles_deg_[i]) return false;
     }
-    return session.direction == header_.direction;
+    return true;
+}
+
+bool ViewStream::Matches(const Session& session) const {
+    return Added() == planned_ && Follows(session);
 }
 
 bool ViewStream::Accept(std::size_t k, PreparedPose pose) {
@@ -75,36 +80,17 @@ void ViewStream::TryTable() {
 }
 
 void ViewStream::SegmentInto(std::size_t k, const DepthMap& depth) {
-    SegmentedView& view = views_.views[k];
-    view = SegmentView(depth, header_.camera, header_.calibration, provisional_->camera_to_table,
-                       config_.segmentation);
-    views_.clouds[k] =
-        BuildRegistrationClouds(view.points, config_.registration.coarse_cloud,
-                                config_.registration.fine_cloud,
-                                provisional_->camera_to_table.translation().cast<float>());
+    SegmentObjectView(depth, header_.camera, header_.calibration, provisional_->camera_to_table,
+                      config_.segmentation, config_.registration.coarse_cloud,
+                      config_.registration.fine_cloud, planned_ == 1, &views_.views[k],
+                      &views_.clouds[k]);
     targets_[k] = std::make_unique<ViewTargets>(views_.clouds[k], config_.registration);
-    // A single view keeps every pixel: with no other view to fuse, its faces' edges are all
-    // the footprint there is, and the fusion stride would cut them short by up to 3 pixels.
-    if (planned_ > 1) view.points = Points{};
-}
-
-std::vector<int> ViewStream::EarlierPairs(int j) const {
-    // A pair's views are at most max_pose_step apart, directly or across the end of the turn
-    // (the first views with the last ones): the candidates are a few, whatever the count.
-    const int step = config_.registration.max_pose_step;
-    std::vector<int> out;
-    for (int i = 0; i < j; ++i) {
-        if (i >= step && i < j - step) i = j - step;  // skip the views between
-        const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
-        if (IsViewPair(i, j, planned_, angles_rad_[ui], angles_rad_[uj], config_.registration)) {
-            out.push_back(i);
-        }
-    }
-    return out;
 }
 
 void ViewStream::Add(double angle_deg, PreparedPose pose) {
-    AddPoses({angle_deg}, {}, std::vector<PreparedPose>{}, &pose);
+    std::vector<PreparedPose> one;
+    one.push_back(std::move(pose));
+    AddPoses({angle_deg}, std::move(one));
 }
 
 void ViewStream::AddAll(const Session& session, std::vector<PreparedPose> poses) {
@@ -112,36 +98,25 @@ void ViewStream::AddAll(const Session& session, std::vector<PreparedPose> poses)
     for (std::size_t i = static_cast<std::size_t>(Added()); i < session.poses.size(); ++i) {
         degrees.push_back(session.poses[i].angle_deg);
     }
-    degrees.resize(std::min(degrees.size(), poses.size()));
-    AddPoses(degrees, session.PoseAnglesRad(), std::move(poses), nullptr);
+    AddPoses(degrees, std::move(poses));
 }
 
-void ViewStream::AddPoses(const std::vector<double>& degrees, const std::vector<double>& session_rad,
-                          std::vector<PreparedPose> poses, PreparedPose* one) {
+void ViewStream::AddPoses(const std::vector<double>& degrees, std::vector<PreparedPose> poses) {
     const double t0 = Now();
     const int first = Added();
-    const int n = std::min(planned_ - first, static_cast<int>(degrees.size()));
+    const int n = std::min({planned_ - first, static_cast<int>(degrees.size()),
+                            static_cast<int>(poses.size())});
     if (n <= 0) return;
     candidates_.resize(static_cast<std::size_t>(planned_));
-    std::vector<char> usable(static_cast<std::size_t>(n), 1);
-    std::vector<PreparedPose*> in(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i) {
-        const auto k = static_cast<std::size_t>(first + i);
-        angles_deg_.push_back(degrees[static_cast<std::size_t>(i)]);
-        if (k < session_rad.size()) {
-            angles_rad_.push_back(session_rad[k]);
-        } else {
-            Session one_pose = header_;
-            one_pose.poses.resize(1);
-            one_pose.poses[0].angle_deg = degrees[static_cast<std::size_t>(i)];
-            angles_rad_.push_back(one_pose.PoseAngleRad(0));
-        }
-        in[static_cast<std::size_t>(i)] = one ? one : &poses[static_cast<std::size_t>(i)];
+        const double deg = degrees[static_cast<std::size_t>(i)];
+        angles_deg_.push_back(deg);
+        angles_rad_.push_back(TurntableAngleRad(deg, header_.direction));
     }
     // Each pose in order: checked, its table candidates, and the provisional table once they
     // locate it — the same sequence whether the poses come one by one or all at once.
     for (int i = 0; i < n && !Blocked(); ++i) {
-        if (!Accept(static_cast<std::size_t>(first + i), std::move(*in[static_cast<std::size_t>(i)])))
+        if (!Accept(static_cast<std::size_t>(first + i), std::move(poses[static_cast<std::size_t>(i)])))
             break;
         TryTable();
     }
@@ -161,7 +136,9 @@ void ViewStream::AddPoses(const std::vector<double>& degrees, const std::vector<
     const double t1 = Now();
     std::vector<std::pair<int, int>> pairs;
     for (int j = from; j < segmented_; ++j) {
-        for (int i : EarlierPairs(j)) pairs.emplace_back(i, j);
+        for (int i : PairedEarlierViews(j, planned_, angles_rad_, config_.registration)) {
+            pairs.emplace_back(i, j);
+        }
     }
     const std::vector<Se2> model = TurntablePoses(angles_rad_);
     std::vector<PairAlignment> aligned(pairs.size());

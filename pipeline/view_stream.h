@@ -46,9 +46,9 @@ public:
     void AddAll(const Session& session, std::vector<PreparedPose> poses);
 
     int Added() const { return static_cast<int>(angles_deg_.size()); }
-    int Planned() const { return planned_; }
-    double AngleDeg(int i) const { return angles_deg_.at(static_cast<std::size_t>(i)); }
-    // Whether the stream was fed exactly the poses (count and angles) of `session`.
+    // Whether the poses added so far are the first ones of `session` (its count, direction
+    // and angles), and whether they are all of them.
+    bool Follows(const Session& session) const;
     bool Matches(const Session& session) const;
 
     // Once every pose is added: refits the table to all poses and moves the views into that
@@ -66,13 +66,10 @@ public:
 private:
     // Takes pose k (its depth checked, its table candidates kept); false when it is unusable.
     bool Accept(std::size_t k, PreparedPose pose);
-    // Add and AddAll: `degrees` of the new poses, the session's model angles when known, the
-    // poses (or `one`, a single pose).
-    void AddPoses(const std::vector<double>& degrees, const std::vector<double>& session_rad,
-                  std::vector<PreparedPose> poses, PreparedPose* one);
+    // Add and AddAll: the new poses with their commanded angles.
+    void AddPoses(const std::vector<double>& degrees, std::vector<PreparedPose> poses);
     void TryTable();  // the provisional table frame from the candidates so far
     void SegmentInto(std::size_t k, const DepthMap& depth);
-    std::vector<int> EarlierPairs(int j) const;  // the views i < j paired with view j
     bool Blocked() const { return unusable_.has_value(); }
     double Now() const { return clock_ ? clock_() : 0.0; }
 

@@ -66,11 +66,7 @@ ViewStream& PosePreparer::Finish(const Session& session) {
     std::deque<Job> backlog;
     backlog.swap(queue_);
     const std::size_t n = session.poses.size();
-    bool same = static_cast<int>(n) == stream_.Planned();
-    for (int i = 0; same && i < stream_.Added(); ++i) {
-        same = stream_.AngleDeg(i) == session.poses[static_cast<std::size_t>(i)].angle_deg;
-    }
-    if (!same) {
+    if (!stream_.Follows(session)) {
         spdlog::warn("pose stream: the capture's poses differ from the plan; starting over");
         stream_ = ViewStream(session, static_cast<int>(n), config_, SteadyClockMs());
         waiting_.clear();

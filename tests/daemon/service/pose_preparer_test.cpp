@@ -12,6 +12,22 @@
 namespace boxd {
 namespace {
 
+// Returns a 6-pose, 2-frame simulated session of `seed`.
+Session SixPoses(unsigned seed) {
+    SyntheticStationConfig c;
+    c.seed = seed;
+    auto session = RenderSyntheticSession(c, 6, 2);
+    EXPECT_TRUE(session.ok());
+    return session.ok() ? *session : Session{};
+}
+
+// Hands pose `i` of `session` to `preparer`, at its angle plus `angle_error_deg`.
+void Hand(PosePreparer& preparer, const Session& session, std::size_t i,
+          double angle_error_deg = 0.0) {
+    preparer.Add(i, session.poses[i].angle_deg + angle_error_deg, session.poses[i].frames,
+                 session.camera.depth_unit_m);
+}
+
 // Returns the session's measurement through a stream fed all at once.
 MeasurementResult AllAtOnce(const Session& session, const MeasureConfig& config) {
     auto out = MeasurePrepared(session, PrepareSession(session, config), config,
@@ -21,22 +37,17 @@ MeasurementResult AllAtOnce(const Session& session, const MeasureConfig& config)
 }
 
 TEST(PosePreparer, StreamsEveryPoseInOrderWhateverArrivedWhen) {
-    SyntheticStationConfig c;
-    c.seed = 9;
-    auto session = RenderSyntheticSession(c, 6, 2);
-    ASSERT_TRUE(session.ok());
+    const Session session = SixPoses(9);
+    ASSERT_EQ(session.poses.size(), 6u);
     const MeasureConfig config;
-    PosePreparer preparer(config, *session, 6);
+    PosePreparer preparer(config, session, 6);
     // Poses 0, 4, 1 arrive (4 before its turn); the others never do.
-    for (std::size_t i : {0, 4, 1}) {
-        preparer.Add(i, session->poses[i].angle_deg, session->poses[i].frames,
-                     session->camera.depth_unit_m);
-    }
-    ViewStream& stream = preparer.Finish(*session);
-    EXPECT_TRUE(stream.Matches(*session));
-    auto streamed = MeasureStreamed(*session, stream, config, BoxMethod::kFootprint);
+    for (std::size_t i : {0, 4, 1}) Hand(preparer, session, i);
+    ViewStream& stream = preparer.Finish(session);
+    EXPECT_TRUE(stream.Matches(session));
+    auto streamed = MeasureStreamed(session, stream, config, BoxMethod::kFootprint);
     ASSERT_TRUE(streamed.ok());
-    const MeasurementResult want = AllAtOnce(*session, config);
+    const MeasurementResult want = AllAtOnce(session, config);
     ASSERT_EQ(streamed->result.status, MeasurementStatus::kOk);
     ASSERT_EQ(want.status, MeasurementStatus::kOk);
     EXPECT_EQ(streamed->result.dimensions->length_m, want.dimensions->length_m);
@@ -46,23 +57,19 @@ TEST(PosePreparer, StreamsEveryPoseInOrderWhateverArrivedWhen) {
 }
 
 TEST(PosePreparer, StartsOverWhenTheCaptureIsNotThePlan) {
-    SyntheticStationConfig c;
-    c.seed = 10;
-    auto session = RenderSyntheticSession(c, 6, 2);
-    ASSERT_TRUE(session.ok());
+    const Session session = SixPoses(10);
+    ASSERT_EQ(session.poses.size(), 6u);
     const MeasureConfig config;
-    PosePreparer preparer(config, *session, 6);
+    PosePreparer preparer(config, session, 6);
     // Pose 1 was streamed at another angle than the session records.
-    preparer.Add(0, session->poses[0].angle_deg, session->poses[0].frames,
-                 session->camera.depth_unit_m);
-    preparer.Add(1, session->poses[1].angle_deg + 7.0, session->poses[1].frames,
-                 session->camera.depth_unit_m);
-    ViewStream& stream = preparer.Finish(*session);
-    EXPECT_TRUE(stream.Matches(*session));
-    auto streamed = MeasureStreamed(*session, stream, config, BoxMethod::kFootprint);
+    Hand(preparer, session, 0);
+    Hand(preparer, session, 1, 7.0);
+    ViewStream& stream = preparer.Finish(session);
+    EXPECT_TRUE(stream.Matches(session));
+    auto streamed = MeasureStreamed(session, stream, config, BoxMethod::kFootprint);
     ASSERT_TRUE(streamed.ok());
     EXPECT_EQ(streamed->result.dimensions->length_m,
-              AllAtOnce(*session, config).dimensions->length_m);
+              AllAtOnce(session, config).dimensions->length_m);
 }
 
 TEST(PosePreparer, StopsCleanlyWithWorkQueued) {
