@@ -98,6 +98,12 @@ Status CaptureConfig::Validate() const {
     if (sweep != "alternate" && sweep != "from_zero") {
         return ConfigError("sweep", "must be alternate or from_zero");
     }
+    if (order != "coverage" && order != "sequential") {
+        return ConfigError("order", "must be coverage or sequential");
+    }
+    if (!(target_uncertainty_m >= 0.0 && target_uncertainty_m <= 0.1)) {
+        return ConfigError("target_uncertainty_m", "must be in [0, 0.1] m (0: every pose)");
+    }
     return OkStatus();
 }
 
@@ -105,7 +111,18 @@ std::vector<double> CaptureConfig::Angles() const {
     if (!angles_deg.empty()) return angles_deg;
     std::vector<double> angles;
     for (int i = 0; i < poses; ++i) angles.push_back(360.0 * i / poses);
-    return angles;
+    if (order == "sequential") return angles;
+    // The coarse pass: every stride-th pose, at most kCoarseStepDeg apart, so that each face's
+    // normal is within half of that of some view; then the rest on the way back, so that the
+    // table never turns further than the sweep itself.
+    constexpr double kCoarseStepDeg = 60.0;
+    const int stride = std::max(1, static_cast<int>(std::floor(kCoarseStepDeg * poses / 360.0)));
+    std::vector<double> ordered;
+    for (int i = 0; i < poses; i += stride) ordered.push_back(angles[static_cast<std::size_t>(i)]);
+    for (int i = poses - 1; i > 0; --i) {
+        if (i % stride != 0) ordered.push_back(angles[static_cast<std::size_t>(i)]);
+    }
+    return ordered;
 }
 
 namespace {
@@ -138,6 +155,14 @@ Sweep PlanSweep(Turntable& turntable, const CaptureConfig& config,
     return s;
 }
 
+// Whether the table is homed, at rest and in position at `angle_deg` (within a hundredth of a
+// degree, the drive's own resolution).
+bool StandsAt(Turntable& turntable, double angle_deg) {
+    auto state = turntable.State();
+    return state && state->homed && !state->moving && state->in_position && !state->fault &&
+           std::abs(state->angle_deg - angle_deg) < 0.01;
+}
+
 }  // namespace
 
 Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
@@ -164,19 +189,29 @@ Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
     };
 
     const Sweep sweep = PlanSweep(turntable, config, angles);
+    if (callbacks.on_plan) {
+        std::vector<double> plan;
+        for (double a : angles) plan.push_back(sweep.sign * (a - angles[0]));
+        callbacks.on_plan(plan);
+    }
     for (int k = 0; k < n; ++k) {
         if (callbacks.on_progress) callbacks.on_progress(k, n);
         if (Cancelled(callbacks)) return cancelled(k);
         const double relative = sweep.sign * (angles[k] - angles[0]);
-        if (auto st = turntable.MoveTo(sweep.start_deg + relative); !st) {
+        // A table already standing at the first pose (where the last sweep ended) needs
+        // neither a move nor time to settle.
+        if (k == 0 && StandsAt(turntable, sweep.start_deg)) {
+            spdlog::debug("capture: the table stands at {:.2f} deg already", sweep.start_deg);
+        } else if (auto st = turntable.MoveTo(sweep.start_deg + relative); !st) {
             if (Cancelled(callbacks)) return cancelled(k);
             StopTable(turntable);
             Error e = st.error();
             e.message =
                 "pose " + std::to_string(k + 1) + " of " + std::to_string(n) + ": " + e.message;
             return e;
+        } else if (!SleepUnlessCancelled(config.settle_ms, callbacks)) {
+            return cancelled(k);
         }
-        if (!SleepUnlessCancelled(config.settle_ms, callbacks)) return cancelled(k);
 
         SessionPose pose;
         pose.angle_deg = relative;
@@ -206,8 +241,15 @@ Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
                       sweep.start_deg + relative, pose.frames.size());
         session.poses.push_back(std::move(pose));
         if (callbacks.on_pose) callbacks.on_pose(session.poses.size() - 1, session.poses.back());
+        if (k + 1 < n && callbacks.stop && callbacks.stop(k + 1)) {
+            spdlog::debug("capture: stopped after pose {} of {}", k + 1, n);
+            break;
+        }
     }
-    if (callbacks.on_progress) callbacks.on_progress(n, n);
+    if (callbacks.on_progress) {
+        const int captured = static_cast<int>(session.poses.size());
+        callbacks.on_progress(captured, captured);
+    }
     return session;
 }
 

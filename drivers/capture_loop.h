@@ -28,11 +28,22 @@ struct CaptureConfig {
     // back between parcels, and the table (and its cables) stays within one turn.
     // "from_zero": every sweep from 0 in the positive direction (`boxd record` always).
     std::string sweep = "alternate";
+    // The order of the poses. "coverage": first every pose of a coarse pass at most 60 degrees
+    // apart (every 3rd of 18), so that after it every face has been seen within 30 degrees of
+    // head-on; then the poses between, on the way back. A measurement can stop as soon as the
+    // box is determined. "sequential": around the turn in order (`boxd record` always).
+    // Explicit angles_deg are taken in the order given.
+    std::string order = "coverage";
+    // A measurement stops turning once every dimension's 95% uncertainty is within this (and
+    // the object is a cuboid); 0 turns through every pose of the budget.
+    double target_uncertainty_m = 0.001;
 
     // Returns an error naming the first invalid field ("capture.<field>: ..."), or Ok.
     Status Validate() const;
     // Returns the table angles of the poses in capture order, in degrees.
     std::vector<double> Angles() const;
+    // Whether a measurement may stop before the last pose.
+    bool Adaptive() const { return target_uncertainty_m > 0.0; }
 };
 
 // What a capture needs besides the devices: what goes into the session.
@@ -42,6 +53,9 @@ struct CaptureStation {
 };
 
 struct CaptureCallbacks {
+    // Called once before the first pose moves with every planned pose's angle as the session
+    // will record it (relative to the first pose, signed by the sweep), in capture order.
+    std::function<void(const std::vector<double>& angles_deg)> on_plan;
     // Called before pose `pose` (0-based) of `poses` starts moving, and once with
     // pose == poses when the capture is complete.
     std::function<void(int pose, int poses)> on_progress;
@@ -52,6 +66,9 @@ struct CaptureCallbacks {
     // When it becomes true the table is stopped (also mid-move) and the capture returns a
     // CANCELLED error.
     const std::atomic<bool>* cancel = nullptr;
+    // Asked after each pose but the last, before the table moves on, with the count of poses
+    // so far: true ends the capture there (the session holds those poses).
+    std::function<bool(int captured)> stop;
 };
 
 // Captures one session with an open camera: for each pose, moves the table, waits settle_ms,

@@ -207,6 +207,8 @@ Result<CaptureConfig> ParseCaptureConfig(const YAML::Node& node) {
                               {"settle_ms", Value(c.settle_ms)},
                               {"grab_timeout_ms", Value(c.grab_timeout_ms)},
                               {"sweep", Value(c.sweep)},
+                              {"order", Value(c.order)},
+                              {"target_uncertainty_m", Value(c.target_uncertainty_m)},
                           });
         !st) {
         return st.error();

@@ -1,5 +1,7 @@
 #include "pipeline/fuse_and_fit.h"
 
+#include <spdlog/spdlog.h>
+
 namespace boxd {
 
 FusedFit FuseAndFit(const std::vector<Points>& view_points, const std::vector<Se2>& poses,
@@ -10,6 +12,7 @@ FusedFit FuseAndFit(const std::vector<Points>& view_points, const std::vector<Se
     out.box = FitFootprintBox(out.fused.points, box_fit);
     out.pca = FitPcaBox(out.fused.points);
     if (laps) laps->Lap("fit");
+    if (!out.box) spdlog::debug("box fit: {}", out.box.error().message);
     if (out.box) {
         out.consistency =
             CheckViewConsistency(out.fused, static_cast<int>(view_points.size()), *out.box, fusion);

@@ -160,8 +160,8 @@ Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<Prepar
                                                " prepared poses for a session of " +
                                                std::to_string(session.poses.size())};
     }
-    ViewStream stream(session, static_cast<int>(session.poses.size()), config, clock);
-    stream.AddAll(session, std::move(poses));
+    ViewStream stream(session, session.PoseAnglesDeg(), config, clock);
+    stream.AddAll(std::move(poses));
     return MeasureStreamed(session, stream, config, method, clock);
 }
 

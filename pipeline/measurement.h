@@ -52,6 +52,9 @@ struct MeasurementQuality {
     std::optional<double> face_excess_ratio;
     // A single view: the faces it does not show were assumed to make a cuboid.
     bool cuboid_assumed = false;
+    // Why a capture stopped turning: "target_uncertainty" (every dimension's bound within the
+    // capture's target), "pose_budget" (every pose of the plan taken); empty offline.
+    std::string stop_reason;
 };
 
 // A 95% bound on each dimension's error, from the data.

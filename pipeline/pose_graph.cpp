@@ -216,15 +216,20 @@ Eigen::VectorXd Leverage(const Eigen::SparseMatrix<double, Eigen::RowMajor>& jac
     return h;
 }
 
-// The covariance of nodes 1..n-1 by variance-component estimation: each group's (edges',
-// prior's) rows are scaled by its factor, its squared whitened residuals over its redundancy
-// Σ (1 − h_ii) with H = J (JᵀJ)⁻¹ Jᵀ — the share of the residuals' degrees of freedom that the
-// group holds — and the split repeated until it settles. A group with less than one degree of
-// freedom keeps its configured weight.
+// The covariance of nodes 1..n-1 by variance-component estimation (Förstner). The residuals fall
+// into three groups, each an error source of its own: the ICP edges; the prior's translations
+// (how far a view sits off a pure rotation about the table's centre: wobble, a loose parcel);
+// and the prior's yaws (the table's angle error). Each group's rows are scaled by its factor, its
+// squared whitened residuals over its redundancy Σ (1 − h_ii) with H = J (JᵀJ)⁻¹ Jᵀ — the share
+// of the residuals' degrees of freedom that the group holds — and the split repeated until it
+// settles. A group with less than one degree of freedom keeps its configured weight.
 std::optional<Eigen::MatrixXd> VarianceComponentCovariance(const Linearization& lin) {
     const Eigen::Index rows = lin.jacobian.rows();
-    const int groups[2][2] = {{0, lin.edge_rows},
-                              {lin.edge_rows, static_cast<int>(rows) - lin.edge_rows}};
+    constexpr int kGroups = 3;  // edges, prior translations, prior yaws
+    std::vector<int> group(static_cast<std::size_t>(rows), 0);
+    for (Eigen::Index r = lin.edge_rows; r < rows; ++r) {
+        group[static_cast<std::size_t>(r)] = (r - lin.edge_rows) % 3 == 2 ? 2 : 1;
+    }
     Eigen::VectorXd scale = Eigen::VectorXd::Ones(rows);
     std::optional<Eigen::MatrixXd> inverse;
     for (int round = 0; round < kVarianceRounds; ++round) {
@@ -234,16 +239,19 @@ std::optional<Eigen::MatrixXd> VarianceComponentCovariance(const Linearization& 
         if (!inverse) return std::nullopt;
         if (round + 1 == kVarianceRounds) break;
         const Eigen::VectorXd leverage = Leverage(wj, *inverse);
-        for (const auto& [first, count] : groups) {
-            const double redundancy = count - leverage.segment(first, count).sum();
-            if (count == 0 || redundancy < 1.0) continue;
-            const double factor = lin.residuals.segment(first, count)
-                                      .cwiseAbs2()
-                                      .cwiseQuotient(scale.segment(first, count))
-                                      .sum() /
-                                  redundancy;
-            scale.segment(first, count) *= std::max(factor, kMinVarianceFactor);
+        double squares[kGroups] = {}, redundancy[kGroups] = {};
+        for (Eigen::Index r = 0; r < rows; ++r) {
+            const int g = group[static_cast<std::size_t>(r)];
+            squares[g] += lin.residuals(r) * lin.residuals(r) / scale(r);
+            redundancy[g] += 1.0 - leverage(r);
         }
+        double factor[kGroups];
+        for (int g = 0; g < kGroups; ++g) {
+            factor[g] = redundancy[g] < 1.0 ? 1.0
+                                            : std::max(squares[g] / redundancy[g],
+                                                       kMinVarianceFactor);
+        }
+        for (Eigen::Index r = 0; r < rows; ++r) scale(r) *= factor[group[static_cast<std::size_t>(r)]];
     }
     return inverse;
 }

@@ -26,4 +26,10 @@ std::vector<double> Session::PoseAnglesRad() const {
     return angles;
 }
 
+std::vector<double> Session::PoseAnglesDeg() const {
+    std::vector<double> angles;
+    for (const SessionPose& pose : poses) angles.push_back(pose.angle_deg);
+    return angles;
+}
+
 }  // namespace boxd

@@ -46,6 +46,8 @@ struct Session {
     double PoseAngleRad(std::size_t i) const;
     // Returns PoseAngleRad of every pose, in pose order.
     std::vector<double> PoseAnglesRad() const;
+    // Returns the commanded angle of every pose (angle_deg), in pose order.
+    std::vector<double> PoseAnglesDeg() const;
 };
 
 // Standard frame path inside a session folder: "pose_003/frame_01.png".

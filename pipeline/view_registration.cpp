@@ -37,44 +37,71 @@ std::vector<Se2> TurntablePoses(const std::vector<double>& table_angles_rad) {
     return poses;
 }
 
-namespace {
-
-// Whether views i < j of a session of `poses` views, at turntable angles `angle_i_rad` and
-// `angle_j_rad`, are aligned: cyclic index distance at most max_pose_step, angles at most
-// max_pair_angle_deg apart.
-bool IsViewPair(int i, int j, int poses, double angle_i_rad, double angle_j_rad,
-                const RegistrationConfig& config) {
-    const int d = j - i;
-    if (d <= 0 || d >= poses) return false;
-    if (std::min(d, poses - d) > config.max_pose_step) return false;
-    const double diff = std::abs(Se2::WrapAngle(angle_i_rad - angle_j_rad));
-    return diff * 180.0 / M_PI <= config.max_pair_angle_deg;
+TurnOrder::TurnOrder(const std::vector<double>& table_angles_rad) {
+    const std::size_t n = table_angles_rad.size();
+    std::vector<double> wrapped(n);
+    for (std::size_t k = 0; k < n; ++k) {
+        const double a = std::fmod(table_angles_rad[k], 2.0 * M_PI);
+        wrapped[k] = a < 0.0 ? a + 2.0 * M_PI : a;
+    }
+    at_.resize(n);
+    for (std::size_t k = 0; k < n; ++k) at_[k] = static_cast<int>(k);
+    std::stable_sort(at_.begin(), at_.end(), [&](int a, int b) {
+        return wrapped[static_cast<std::size_t>(a)] < wrapped[static_cast<std::size_t>(b)];
+    });
+    rank_.resize(n);
+    for (std::size_t r = 0; r < n; ++r) rank_[static_cast<std::size_t>(at_[r])] = static_cast<int>(r);
 }
 
-}  // namespace
+int TurnOrder::Neighbour(int pose, int steps) const {
+    const int n = size();
+    const int r = ((RankOf(pose) + steps) % n + n) % n;
+    return at_[static_cast<std::size_t>(r)];
+}
 
-std::vector<int> PairedEarlierViews(int j, int poses, const std::vector<double>& table_angles_rad,
+std::vector<int> PairedEarlierViews(int j, const TurnOrder& order,
+                                    const std::vector<double>& plan_rad,
                                     const RegistrationConfig& config) {
-    // A pair's views are at most max_pose_step apart, directly or across the end of the turn
-    // (the first views with the last ones): the candidates are a few, whatever the count.
-    const int step = config.max_pose_step;
+    // The candidates are the few views within max_pose_step places on either side, whatever
+    // the count.
     std::vector<int> out;
-    for (int i = 0; i < j; ++i) {
-        if (i >= step && i < j - step) i = j - step;  // skip the views between
-        const auto ui = static_cast<std::size_t>(i), uj = static_cast<std::size_t>(j);
-        if (IsViewPair(i, j, poses, table_angles_rad[ui], table_angles_rad[uj], config)) {
-            out.push_back(i);
+    const int n = order.size();
+    const int reach = std::min(config.max_pose_step, n - 1);
+    const auto uj = static_cast<std::size_t>(j);
+    for (int d = 1; d <= reach; ++d) {
+        for (int side : {1, -1}) {
+            const int i = order.Neighbour(j, side * d);
+            if (i >= j || std::find(out.begin(), out.end(), i) != out.end()) continue;
+            const double diff =
+                std::abs(Se2::WrapAngle(plan_rad[static_cast<std::size_t>(i)] - plan_rad[uj]));
+            if (diff * 180.0 / M_PI <= config.max_pair_angle_deg) out.push_back(i);
         }
     }
+    std::sort(out.begin(), out.end());
     return out;
+}
+
+void MarkLoopClosures(std::vector<PoseEdge>& edges, const std::vector<double>& table_angles_rad) {
+    const TurnOrder order(table_angles_rad);
+    const int n = order.size();
+    // Pose 0's neighbour captured later closes the loop; two poses have one pair, no loop.
+    const int closing = n >= 3 ? std::max(order.Neighbour(0, 1), order.Neighbour(0, -1)) : -1;
+    for (PoseEdge& e : edges) {
+        if (e.from >= n || e.to >= n) continue;
+        const int d = std::abs(order.RankOf(e.from) - order.RankOf(e.to));
+        const bool neighbours = std::min(d, n - d) == 1;
+        const bool closes = std::min(e.from, e.to) == 0 && std::max(e.from, e.to) == closing;
+        e.loop_closure = !neighbours || closes;
+    }
 }
 
 std::vector<std::pair<int, int>> ViewPairs(const std::vector<double>& table_angles_rad,
                                            const RegistrationConfig& config) {
     const int n = static_cast<int>(table_angles_rad.size());
+    const TurnOrder order(table_angles_rad);
     std::vector<std::pair<int, int>> pairs;
     for (int j = 1; j < n; ++j) {
-        for (int i : PairedEarlierViews(j, n, table_angles_rad, config)) pairs.emplace_back(i, j);
+        for (int i : PairedEarlierViews(j, order, table_angles_rad, config)) pairs.emplace_back(i, j);
     }
     std::sort(pairs.begin(), pairs.end());
     return pairs;
@@ -98,7 +125,6 @@ PairAlignment AlignViewPair(int i, int j, const ViewClouds& view_j, const ViewTa
     edge.measured = out.fine.transform;
     edge.information = out.fine.information;
     edge.point_scatter = out.fine.point_scatter;
-    edge.loop_closure = !(j == i + 1);
     return out;
 }
 
@@ -149,7 +175,9 @@ std::vector<PoseEdge> RegisterViewPairs(const std::vector<ViewClouds>& views,
             i, j, views[static_cast<std::size_t>(j)], *targets[static_cast<std::size_t>(i)],
             model, config);
     });
-    return AcceptedEdges(alignments, config, stats);
+    std::vector<PoseEdge> edges = AcceptedEdges(alignments, config, stats);
+    MarkLoopClosures(edges, table_angles_rad);
+    return edges;
 }
 
 }  // namespace boxd

@@ -49,15 +49,39 @@ struct EdgeStats {
 // which maps view k's points back into the frame of pose 0.
 std::vector<Se2> TurntablePoses(const std::vector<double>& table_angles_rad);
 
-// Returns the views i < j that view j of a session of `poses` views is aligned with: cyclic index
-// distance at most max_pose_step, turntable angles at most max_pair_angle_deg apart. Reads only
-// the angles of views 0..j, so a capture can ask as soon as view j arrives.
-std::vector<int> PairedEarlierViews(int j, int poses, const std::vector<double>& table_angles_rad,
+// The poses of a session (or of a capture's plan) in their order around the turn: each pose's
+// rank when its angle, wrapped into one turn, is sorted (ties in pose order). A capture may
+// take its poses in any order (a sweep forwards, backwards, or the coverage order's passes);
+// which views are neighbours depends only on where they stand.
+class TurnOrder {
+public:
+    explicit TurnOrder(const std::vector<double>& table_angles_rad);
+    int size() const { return static_cast<int>(rank_.size()); }
+    int RankOf(int pose) const { return rank_[static_cast<std::size_t>(pose)]; }
+    // The pose `steps` places after `pose` around the turn (negative: before), cyclically.
+    int Neighbour(int pose, int steps) const;
+
+private:
+    std::vector<int> rank_, at_;
+};
+
+// Returns the views i < j that view j is aligned with: at most max_pose_step places apart
+// around the turn of the planned poses `plan_rad` (cyclically: the first ones with the last
+// ones), turntable angles at most max_pair_angle_deg apart. For a session captured in order
+// around the turn that is the cyclic index distance. Reads only the angles, so a capture can ask
+// as soon as view j arrives.
+std::vector<int> PairedEarlierViews(int j, const TurnOrder& order,
+                                    const std::vector<double>& plan_rad,
                                     const RegistrationConfig& config);
 
 // Returns every pair (i, j), i < j, of PairedEarlierViews, sorted.
 std::vector<std::pair<int, int>> ViewPairs(const std::vector<double>& table_angles_rad,
                                            const RegistrationConfig& config);
+
+// Marks the loop closures among `edges` of the session at `table_angles_rad`: every edge but
+// those between neighbours around the turn, and of those the one that closes the loop (pose 0
+// with the later captured of its two neighbours). Robust losses go on loop closures.
+void MarkLoopClosures(std::vector<PoseEdge>& edges, const std::vector<double>& table_angles_rad);
 
 // One view's registration clouds with their search indices, built once.
 struct ViewTargets {

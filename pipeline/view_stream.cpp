@@ -29,27 +29,86 @@ std::vector<Eigen::Vector3d> EvenSubsample(std::vector<Eigen::Vector3d> pts, std
 
 }  // namespace
 
-ViewStream::ViewStream(const Session& header, int poses, MeasureConfig config, MonotonicMs clock)
-    : planned_(std::max(0, poses)), config_(std::move(config)), clock_(std::move(clock)) {
+namespace {
+
+std::vector<double> TableAnglesRad(const std::vector<double>& degrees, TurntableDirection dir) {
+    std::vector<double> out;
+    for (double d : degrees) out.push_back(TurntableAngleRad(d, dir));
+    return out;
+}
+
+}  // namespace
+
+ViewStream::ViewStream(const Session& header, std::vector<double> plan_deg, MeasureConfig config,
+                       MonotonicMs clock)
+    : config_(std::move(config)),
+      plan_deg_(std::move(plan_deg)),
+      plan_rad_(TableAnglesRad(plan_deg_, header.direction)),
+      order_(plan_rad_),
+      clock_(std::move(clock)) {
     header_.camera = header.camera;
     header_.calibration = header.calibration;
     header_.direction = header.direction;
-    views_.views.resize(static_cast<std::size_t>(planned_));
-    views_.clouds.resize(static_cast<std::size_t>(planned_));
-    targets_.resize(static_cast<std::size_t>(planned_));
+    const auto n = plan_deg_.size();
+    views_.views.resize(n);
+    views_.clouds.resize(n);
+    targets_.resize(n);
+    candidates_.resize(n);
+    PlanPairs();
+}
+
+void ViewStream::PlanPairs() {
+    last_partner_.assign(plan_deg_.size(), -1);
+    for (int j = 1; j < Planned(); ++j) {
+        for (int i : PairedEarlierViews(j, order_, plan_rad_, config_.registration)) {
+            last_partner_[static_cast<std::size_t>(i)] = j;
+        }
+    }
 }
 
 bool ViewStream::Follows(const Session& session) const {
-    if (static_cast<int>(session.poses.size()) != planned_) return false;
+    if (static_cast<int>(session.poses.size()) != Planned()) return false;
     if (session.direction != header_.direction) return false;
-    for (std::size_t i = 0; i < angles_deg_.size(); ++i) {
-        if (session.poses[i].angle_deg != angles_deg_[i]) return false;
+    for (std::size_t i = 0; i < plan_deg_.size(); ++i) {
+        if (session.poses[i].angle_deg != plan_deg_[i]) return false;
     }
     return true;
 }
 
 bool ViewStream::Matches(const Session& session) const {
-    return Added() == planned_ && Follows(session);
+    return Added() == Planned() && Follows(session);
+}
+
+void ViewStream::Truncate(int poses) {
+    const auto n = static_cast<std::size_t>(std::clamp(poses, Added(), Planned()));
+    plan_deg_.resize(n);
+    plan_rad_.resize(n);
+    order_ = TurnOrder(plan_rad_);
+    views_.views.resize(n);
+    views_.clouds.resize(n);
+    targets_.resize(n);
+    candidates_.resize(n);
+    PlanPairs();
+}
+
+std::unique_ptr<ViewStream> ViewStream::SoFar() const {
+    if (!pending_.empty()) return nullptr;
+    const auto n = static_cast<std::size_t>(Added());
+    std::vector<double> plan(plan_deg_.begin(), plan_deg_.begin() + static_cast<long>(n));
+    auto copy = std::make_unique<ViewStream>(header_, std::move(plan), config_, clock_);
+    copy->added_ = added_;
+    copy->unusable_ = unusable_;
+    copy->table_error_ = table_error_;
+    std::copy(candidates_.begin(), candidates_.begin() + static_cast<long>(n),
+              copy->candidates_.begin());
+    copy->provisional_ = provisional_;
+    copy->segmented_ = segmented_;
+    std::copy(views_.views.begin(), views_.views.begin() + static_cast<long>(n),
+              copy->views_.views.begin());
+    std::copy(views_.clouds.begin(), views_.clouds.begin() + static_cast<long>(n),
+              copy->views_.clouds.begin());
+    copy->alignments_ = alignments_;
+    return copy;
 }
 
 bool ViewStream::Accept(std::size_t k, PreparedPose pose) {
@@ -59,7 +118,8 @@ bool ViewStream::Accept(std::size_t k, PreparedPose pose) {
         return false;
     }
     const std::size_t share = std::max<std::size_t>(
-        100, std::min(kCandidatesPerPose, kCandidatesInAll / static_cast<std::size_t>(planned_)));
+        100, std::min(kCandidatesPerPose,
+                      kCandidatesInAll / std::max<std::size_t>(1, plan_deg_.size())));
     candidates_[k] = EvenSubsample(
         TableCandidates(*depth, header_.camera, header_.calibration, config_.table_plane), share);
     pending_.push_back(std::move(*depth));
@@ -82,37 +142,25 @@ void ViewStream::TryTable() {
 void ViewStream::SegmentInto(std::size_t k, const DepthMap& depth) {
     SegmentObjectView(depth, header_.camera, header_.calibration, provisional_->camera_to_table,
                       config_.segmentation, config_.registration.coarse_cloud,
-                      config_.registration.fine_cloud, planned_ == 1, &views_.views[k],
+                      config_.registration.fine_cloud, Planned() == 1, &views_.views[k],
                       &views_.clouds[k]);
     targets_[k] = std::make_unique<ViewTargets>(views_.clouds[k], config_.registration);
 }
 
-void ViewStream::Add(double angle_deg, PreparedPose pose) {
+void ViewStream::Add(PreparedPose pose) {
     std::vector<PreparedPose> one;
     one.push_back(std::move(pose));
-    AddPoses({angle_deg}, std::move(one));
+    AddPoses(std::move(one));
 }
 
-void ViewStream::AddAll(const Session& session, std::vector<PreparedPose> poses) {
-    std::vector<double> degrees;
-    for (std::size_t i = static_cast<std::size_t>(Added()); i < session.poses.size(); ++i) {
-        degrees.push_back(session.poses[i].angle_deg);
-    }
-    AddPoses(degrees, std::move(poses));
-}
+void ViewStream::AddAll(std::vector<PreparedPose> poses) { AddPoses(std::move(poses)); }
 
-void ViewStream::AddPoses(const std::vector<double>& degrees, std::vector<PreparedPose> poses) {
+void ViewStream::AddPoses(std::vector<PreparedPose> poses) {
     const double t0 = Now();
     const int first = Added();
-    const int n = std::min({planned_ - first, static_cast<int>(degrees.size()),
-                            static_cast<int>(poses.size())});
+    const int n = std::min(Planned() - first, static_cast<int>(poses.size()));
     if (n <= 0) return;
-    candidates_.resize(static_cast<std::size_t>(planned_));
-    for (int i = 0; i < n; ++i) {
-        const double deg = degrees[static_cast<std::size_t>(i)];
-        angles_deg_.push_back(deg);
-        angles_rad_.push_back(TurntableAngleRad(deg, header_.direction));
-    }
+    added_ += n;
     // Each pose in order: checked, its table candidates, and the provisional table once they
     // locate it — the same sequence whether the poses come one by one or all at once.
     for (int i = 0; i < n && !Blocked(); ++i) {
@@ -136,11 +184,11 @@ void ViewStream::AddPoses(const std::vector<double>& degrees, std::vector<Prepar
     const double t1 = Now();
     std::vector<std::pair<int, int>> pairs;
     for (int j = from; j < segmented_; ++j) {
-        for (int i : PairedEarlierViews(j, planned_, angles_rad_, config_.registration)) {
+        for (int i : PairedEarlierViews(j, order_, plan_rad_, config_.registration)) {
             pairs.emplace_back(i, j);
         }
     }
-    const std::vector<Se2> model = TurntablePoses(angles_rad_);
+    const std::vector<Se2> model = TurntablePoses(plan_rad_);
     std::vector<PairAlignment> aligned(pairs.size());
     ParallelFor(static_cast<int>(pairs.size()), config_.threads, [&](int e) {
         const auto [i, j] = pairs[static_cast<std::size_t>(e)];
@@ -149,15 +197,17 @@ void ViewStream::AddPoses(const std::vector<double>& degrees, std::vector<Prepar
                           *targets_[static_cast<std::size_t>(i)], model, config_.registration);
     });
     for (PairAlignment& a : aligned) alignments_.push_back(std::move(a));
-    // A view's search index is done with once no later view can pair with it: the ones more
-    // than max_pose_step back, except the first few, which close the loop with the last ones.
-    const int step = config_.registration.max_pose_step;
-    for (int i = step; i < segmented_ - step; ++i) targets_[static_cast<std::size_t>(i)].reset();
+    // A view's search index is done with once the last view it is aligned with is in.
+    for (int i = 0; i < segmented_; ++i) {
+        if (last_partner_[static_cast<std::size_t>(i)] < segmented_) {
+            targets_[static_cast<std::size_t>(i)].reset();
+        }
+    }
     align_ms_ += (Now() - t1);
 }
 
 std::optional<MeasurementReason> ViewStream::Complete() {
-    if (planned_ == 0) {
+    if (Planned() == 0) {
         return MeasurementReason{ErrorCode::kInsufficientData, "the session has no poses"};
     }
     if (unusable_) return unusable_;
@@ -202,7 +252,9 @@ std::vector<PoseEdge> ViewStream::Edges(EdgeStats* stats) const {
     std::sort(sorted.begin(), sorted.end(), [](const PairAlignment& a, const PairAlignment& b) {
         return std::pair(a.edge.from, a.edge.to) < std::pair(b.edge.from, b.edge.to);
     });
-    return AcceptedEdges(sorted, config_.registration, stats);
+    std::vector<PoseEdge> edges = AcceptedEdges(sorted, config_.registration, stats);
+    MarkLoopClosures(edges, plan_rad_);
+    return edges;
 }
 
 }  // namespace boxd

@@ -32,24 +32,33 @@ namespace boxd {
 class ViewStream {
 public:
     // `header`: the session's camera, calibration and turntable direction (its poses are not
-    // read); `poses`: how many poses the session will have (the loop closures pair its last
-    // poses with its first ones).
-    // `clock` times the stages (their laps stay zero without one).
-    ViewStream(const Session& header, int poses, MeasureConfig config, MonotonicMs clock = {});
+    // read); `plan_deg`: the commanded angles of the poses the session will have, in the order
+    // they come (which views are neighbours around the turn, and so are aligned, depends on all
+    // of them). `clock` times the stages (their laps stay zero without one).
+    ViewStream(const Session& header, std::vector<double> plan_deg, MeasureConfig config,
+               MonotonicMs clock = {});
 
-    // Adds the next pose (index Added()), commanded `angle_deg` from pose 0, and does its share
-    // of the stages. Poses beyond the announced count are ignored.
-    void Add(double angle_deg, PreparedPose pose);
+    // Adds the next pose of the plan (index Added()) and does its share of the stages. Poses
+    // beyond the plan are ignored.
+    void Add(PreparedPose pose);
 
-    // Adds every pose of `session` (prepared in pose order) to an empty stream, each stage on
+    // Adds the poses that follow (prepared, in plan order) at once, each stage on
     // config.threads threads.
-    void AddAll(const Session& session, std::vector<PreparedPose> poses);
+    void AddAll(std::vector<PreparedPose> poses);
 
-    int Added() const { return static_cast<int>(angles_deg_.size()); }
-    // Whether the poses added so far are the first ones of `session` (its count, direction
-    // and angles), and whether they are all of them.
+    int Added() const { return added_; }
+    int Planned() const { return static_cast<int>(plan_deg_.size()); }
+    // Whether `session` is the planned one (its count, direction and angles), and whether every
+    // one of its poses is in.
     bool Follows(const Session& session) const;
     bool Matches(const Session& session) const;
+    // Ends the plan after its first `poses` poses (not fewer than Added()): a capture that
+    // stopped early. The alignments made so far stay.
+    void Truncate(int poses);
+    // A copy of the poses added so far, as a stream whose plan ends there, for a measurement
+    // of them while this one goes on (its views are copied; no alignment can be added to it).
+    // Null while some pose waits for the table.
+    std::unique_ptr<ViewStream> SoFar() const;
 
     // Once every pose is added: refits the table to all poses and moves the views into that
     // frame (once), and returns the first refusal in the stages' order (an unusable pose, then
@@ -67,16 +76,21 @@ private:
     // Takes pose k (its depth checked, its table candidates kept); false when it is unusable.
     bool Accept(std::size_t k, PreparedPose pose);
     // Add and AddAll: the new poses with their commanded angles.
-    void AddPoses(const std::vector<double>& degrees, std::vector<PreparedPose> poses);
+    void AddPoses(std::vector<PreparedPose> poses);
     void TryTable();  // the provisional table frame from the candidates so far
     void SegmentInto(std::size_t k, const DepthMap& depth);
     bool Blocked() const { return unusable_.has_value(); }
     double Now() const { return clock_ ? clock_() : 0.0; }
 
+    // The pose each view's search index waits for: the last planned view it is aligned with.
+    void PlanPairs();
+
     Session header_;
-    int planned_;
     MeasureConfig config_;
-    std::vector<double> angles_deg_, angles_rad_;
+    std::vector<double> plan_deg_, plan_rad_;
+    TurnOrder order_;
+    std::vector<int> last_partner_;
+    int added_ = 0;
     std::optional<MeasurementReason> unusable_, table_error_;
     std::vector<std::vector<Eigen::Vector3d>> candidates_;  // per pose, subsampled
     std::optional<TablePlaneFit> provisional_;

@@ -64,6 +64,7 @@ int RunRecord(const RecordOptions& options) {
     // A recording keeps the fixed schedule: from 0, forwards.
     CaptureConfig capture = devices->capture;
     capture.sweep = "from_zero";
+    capture.order = "sequential";  // a recording keeps the fixed schedule
     auto session = CaptureSession(*devices->turntable, *devices->camera, capture,
                                   devices->station, callbacks);
     devices->camera->Close();

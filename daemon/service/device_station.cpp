@@ -137,22 +137,37 @@ Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms
     callbacks.on_progress = [&ctx](int pose, int n) {
         if (ctx.progress) ctx.progress(JobProgress{"capture", pose, n});
     };
-    if (preparer) {
+    CaptureConfig capture = devices->capture;
+    if (!preparer) {
+        capture.order = "sequential";  // a calibration turns through the fixed schedule
+        capture.target_uncertainty_m = 0.0;
+    } else {
         Session header;
         header.camera = devices->camera->Intrinsics();
         header.calibration = devices->station.calibration;
         header.direction = devices->station.direction;
-        *preparer = std::make_unique<PosePreparer>(config_.measure, header, poses);
-        PosePreparer* p = preparer->get();
         const double unit = header.camera.depth_unit_m;
-        callbacks.on_pose = [p, unit](std::size_t index, const SessionPose& pose) {
-            p->Add(index, pose.angle_deg, pose.frames, unit);
+        // The preparer starts with the plan; each pose goes to it as soon as it is grabbed, and
+        // the table turns on until the poses so far determine the box.
+        callbacks.on_plan = [this, preparer, header, target = capture.target_uncertainty_m](
+                                const std::vector<double>& plan) {
+            *preparer = std::make_unique<PosePreparer>(config_.measure, header, plan, target,
+                                                       config_.method);
         };
+        callbacks.on_pose = [preparer, unit, this](std::size_t index, const SessionPose& pose) {
+            last_frame_at_ = std::chrono::steady_clock::now();
+            (*preparer)->Add(index, pose.angle_deg, pose.frames, unit);
+        };
+        callbacks.stop = [preparer](int captured) { return (*preparer)->ShouldStop(captured); };
     }
     const auto t_capture = std::chrono::steady_clock::now();
-    Result<Session> session = CaptureSession(*devices->turntable, *devices->camera,
-                                             devices->capture, devices->station, callbacks);
-    capture_ms = MsSince(t_capture);
+    last_frame_at_ = t_capture;
+    Result<Session> session = CaptureSession(*devices->turntable, *devices->camera, capture,
+                                             devices->station, callbacks);
+    // Up to the last frame: what comes after it (a last measurement so far) is processing.
+    capture_ms = std::chrono::duration<double, std::milli>(
+                     (preparer ? last_frame_at_ : std::chrono::steady_clock::now()) - t_capture)
+                     .count();
     if (!session) {
         const Error& e = session.error();
         if (e.code == ErrorCode::kTurntableError || e.code == ErrorCode::kCameraError)
@@ -166,6 +181,9 @@ JobOutput DeviceStation::Measure(const JobContext& ctx) {
     std::unique_ptr<PosePreparer> preparer;
     Result<Session> session = Capture(ctx, capture_ms, &preparer);
     const int streamed_during_capture = preparer ? preparer->Streamed() : 0;
+    // Whether the capture stopped turning before its last pose because the box was determined.
+    const bool stopped_early = session && preparer && preparer->Determined() &&
+                               static_cast<int>(session->poses.size()) < preparer->Planned();
     if (!session) {
         JobOutput out = FailedOutput(session.error().code, session.error().message);
         out.result.timing_ms["capture"] = capture_ms;
@@ -190,23 +208,31 @@ JobOutput DeviceStation::Measure(const JobContext& ctx) {
     }
 
     // Processing: the views and their alignments were made pose by pose during the capture;
-    // the pose graph, fusion and the fits need them all.
+    // the pose graph, fusion and the fits need them all — unless the measurement that stopped
+    // the table was of these very poses.
     if (ctx.progress) ctx.progress(JobProgress{"processing", poses, poses});
-    const auto t_processing = std::chrono::steady_clock::now();
-    ViewStream& stream = preparer->Finish(*session);
-    spdlog::info("measurement {}: {} of {} poses streamed during the capture", ctx.id,
-                 streamed_during_capture, poses);
-    Result<MeasureOutput> measured = MeasureStreamed(*session, stream, config_.measure,
-                                                     config_.method, SteadyClockMs());
+    if (!preparer) return FailedOutput(ErrorCode::kInternal, "the capture made no plan");
+    std::optional<MeasureOutput> measured = preparer->TakeDetermined(*session);
+    spdlog::info("measurement {}: {} of {} poses streamed during the capture ({})", ctx.id,
+                 streamed_during_capture, poses,
+                 stopped_early ? "the box was determined, the table stopped early"
+                               : "every pose of the plan");
     if (!measured) {
-        JobOutput failed = FailedOutput(measured.error().code, measured.error().message);
-        failed.result.timing_ms["capture"] = capture_ms;
-        return failed;
+        ViewStream& stream = preparer->Finish(*session);
+        Result<MeasureOutput> streamed = MeasureStreamed(*session, stream, config_.measure,
+                                                         config_.method, SteadyClockMs());
+        if (!streamed) {
+            JobOutput failed = FailedOutput(streamed.error().code, streamed.error().message);
+            failed.result.timing_ms["capture"] = capture_ms;
+            return failed;
+        }
+        measured = std::move(*streamed);
     }
     out.result = std::move(measured->result);
     out.result.timing_ms["capture"] = capture_ms;
-    // From the end of the capture to the result: what the overlap shortens.
-    out.result.timing_ms["processing"] = MsSince(t_processing);
+    out.result.quality.stop_reason = stopped_early ? "target_uncertainty" : "pose_budget";
+    // From the last frame to the result: what the overlap shortens.
+    out.result.timing_ms["processing"] = MsSince(last_frame_at_);
     if (!measured->cloud.empty()) {
         const auto ply = ctx.scratch_dir / "cloud.ply";
         if (Status s = WritePly(ply, measured->cloud); s) {

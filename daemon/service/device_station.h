@@ -6,6 +6,7 @@
 // the last one.
 
 #include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -66,6 +67,8 @@ private:
     std::string turntable_description_;         // guarded by devices_mutex_
     std::string camera_description_;            // guarded by devices_mutex_
     std::filesystem::path calibration_source_;  // the file the calibration in force came from
+    // When the last pose of the capture in progress was grabbed (the job thread's).
+    std::chrono::steady_clock::time_point last_frame_at_;
 };
 
 }  // namespace boxd

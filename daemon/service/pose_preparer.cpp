@@ -2,13 +2,37 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "pipeline/parallel_for.h"
 
 namespace boxd {
 
-PosePreparer::PosePreparer(MeasureConfig config, const Session& header, int poses)
+double WidestGapDeg(std::vector<double> angles_deg) {
+    if (angles_deg.size() < 2) return 360.0;
+    for (double& a : angles_deg) {
+        a = std::fmod(a, 360.0);
+        if (a < 0.0) a += 360.0;
+    }
+    std::sort(angles_deg.begin(), angles_deg.end());
+    double widest = angles_deg.front() + 360.0 - angles_deg.back();
+    for (std::size_t i = 1; i < angles_deg.size(); ++i) {
+        widest = std::max(widest, angles_deg[i] - angles_deg[i - 1]);
+    }
+    return widest;
+}
+
+PosePreparer::PosePreparer(MeasureConfig config, const Session& header,
+                           std::vector<double> plan_deg, double target_uncertainty_m,
+                           BoxMethod method)
     : config_(std::move(config)),
-      stream_(header, poses, config_, SteadyClockMs()),
+      header_(header),
+      target_m_(target_uncertainty_m),
+      method_(method),
+      planned_(static_cast<int>(plan_deg.size())),
+      plan_deg_(plan_deg),
+      stream_(header, std::move(plan_deg), config_, SteadyClockMs()),
       worker_([this] { Work(); }) {}
 
 PosePreparer::~PosePreparer() {
@@ -44,12 +68,82 @@ void PosePreparer::Work() {
         for (auto it = waiting_.find(static_cast<std::size_t>(stream_.Added()));
              it != waiting_.end();
              it = waiting_.find(static_cast<std::size_t>(stream_.Added()))) {
-            stream_.Add(it->second.first, std::move(it->second.second));
+            streamed_deg_.push_back(it->second.first);
+            stream_.Add(std::move(it->second.second));
             waiting_.erase(it);
             streamed_.store(stream_.Added());
         }
+        TryDetermine();
         lock.lock();
     }
+}
+
+void PosePreparer::TryDetermine() {
+    const int added = stream_.Added();
+    // Records what the measurement of the first `added` poses found (or that there was none).
+    auto done = [this, added](bool trial, double worst_m,
+                              std::optional<MeasureOutput> determining) {
+        {
+            std::lock_guard lock(mutex_);
+            measured_ = added;
+            if (trial) ++trials_;
+            last_worst_m_ = worst_m;
+            if (determining) determining_.emplace(added, std::move(*determining));
+        }
+        if (determining) determined_.store(true);
+        measured_cv_.notify_all();
+    };
+    if (target_m_ <= 0.0 || determined_.load() || !waiting_.empty()) return;
+    {
+        std::lock_guard lock(mutex_);
+        if (!queue_.empty() || stop_) return;  // a newer pose is here: measure with it
+    }
+    if (WidestGapDeg(streamed_deg_) > kSurroundGapDeg) return done(false, INFINITY, std::nullopt);
+    std::unique_ptr<ViewStream> so_far = stream_.SoFar();
+    if (!so_far) return done(false, INFINITY, std::nullopt);
+    Session session = header_;
+    session.poses.clear();
+    for (double a : streamed_deg_) session.poses.push_back(SessionPose{a, {}, {}});
+    auto out = MeasureStreamed(session, *so_far, config_, method_, SteadyClockMs());
+    if (!out) return done(true, INFINITY, std::nullopt);
+    const MeasurementResult& r = out->result;
+    const bool cuboid = r.status == MeasurementStatus::kOk && r.shape == "cuboid" && r.uncertainty_m;
+    const double worst = cuboid ? std::max({r.uncertainty_m->length_m, r.uncertainty_m->width_m,
+                                            r.uncertainty_m->height_m})
+                                : INFINITY;
+    spdlog::debug("pose stream: {} poses measure {}, worst 95% bound {:.2f} mm", added,
+                  cuboid ? "a cuboid" : "no cuboid", worst * 1e3);
+    if (!(worst <= target_m_)) return done(true, worst, std::nullopt);
+    // The stages the stream did pose by pose count in their laps, as in MeasureStreamed.
+    out->result.timing_ms["preprocess"] += stream_.segment_ms();
+    out->result.timing_ms["registration"] += stream_.align_ms();
+    done(true, worst, std::move(*out));
+}
+
+bool PosePreparer::ShouldStop(int captured) {
+    if (target_m_ <= 0.0) return false;
+    if (determined_.load()) return true;
+    const auto n = std::min(static_cast<std::size_t>(std::max(captured, 0)), plan_deg_.size());
+    if (WidestGapDeg({plan_deg_.begin(), plan_deg_.begin() + static_cast<long>(n)}) >
+        kSurroundGapDeg) {
+        return false;
+    }
+    std::unique_lock lock(mutex_);
+    const bool first = trials_ == 0;
+    const bool close = last_worst_m_ <= kCloseFactor * target_m_;
+    if (!first && !close) return determined_.load();
+    measured_cv_.wait_for(lock, std::chrono::seconds(5),
+                          [&] { return measured_ >= captured || stop_; });
+    return determined_.load();
+}
+
+std::optional<MeasureOutput> PosePreparer::TakeDetermined(const Session& session) {
+    std::lock_guard lock(mutex_);
+    if (!determining_ || determining_->first != static_cast<int>(session.poses.size()))
+        return std::nullopt;
+    std::optional<MeasureOutput> out = std::move(determining_->second);
+    determining_.reset();
+    return out;
 }
 
 int PosePreparer::Streamed() const { return streamed_.load(); }
@@ -66,9 +160,12 @@ ViewStream& PosePreparer::Finish(const Session& session) {
     std::deque<Job> backlog;
     backlog.swap(queue_);
     const std::size_t n = session.poses.size();
+    if (static_cast<int>(n) < stream_.Planned() && static_cast<int>(n) >= stream_.Added()) {
+        stream_.Truncate(static_cast<int>(n));  // the capture stopped early
+    }
     if (!stream_.Follows(session)) {
         spdlog::warn("pose stream: the capture's poses differ from the plan; starting over");
-        stream_ = ViewStream(session, static_cast<int>(n), config_, SteadyClockMs());
+        stream_ = ViewStream(session, session.PoseAnglesDeg(), config_, SteadyClockMs());
         waiting_.clear();
         backlog.clear();
     }
@@ -91,7 +188,7 @@ ViewStream& PosePreparer::Finish(const Session& session) {
         }
     });
     waiting_.clear();
-    stream_.AddAll(session, std::move(rest));
+    stream_.AddAll(std::move(rest));
     return stream_;
 }
 

@@ -48,6 +48,8 @@ Status SimulatedCamera::Open() {
     scene_ = MakeSyntheticScene(config_.station);
     open_ = true;
     pose_index_ = -1;
+    streaming_since_ = std::chrono::steady_clock::now();
+    last_frame_tick_ = -1;
     return OkStatus();
 }
 
@@ -68,7 +70,13 @@ Result<DepthImage> SimulatedCamera::Grab(std::chrono::milliseconds timeout) {
             return CameraError("simulated camera: no depth frame within " +
                                std::to_string(timeout.count()) + " ms");
         }
-        std::this_thread::sleep_for(std::chrono::milliseconds(config_.frame_interval_ms));
+        // The next frame the sensor exposes: at the next tick of its period, one frame per tick.
+        const auto period = std::chrono::milliseconds(config_.frame_interval_ms);
+        const auto since = std::chrono::steady_clock::now() - streaming_since_;
+        const long long tick = std::max(last_frame_tick_ + 1,
+                                        static_cast<long long>((since + period - std::chrono::nanoseconds(1)) / period));
+        std::this_thread::sleep_until(streaming_since_ + tick * period);
+        last_frame_tick_ = tick;
     }
     const Result<double> reported = angle_deg_();
     if (!reported) {

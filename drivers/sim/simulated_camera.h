@@ -4,6 +4,7 @@
 // same Modbus turntable driver, as a real one.
 
 #include <cstdint>
+#include <chrono>
 #include <functional>
 #include <string>
 
@@ -17,8 +18,9 @@ struct SimulatedCameraConfig {
     // Box, camera placement, disc, noise, seed and the injected calibration errors. Its
     // `camera` intrinsics come from the `camera:` section (intrinsics, depth_unit_m).
     SyntheticStationConfig station;
-    // Pause before each frame, like a sensor's frame period; 0 returns frames as fast as they
-    // render.
+    // The sensor's frame period: a frame is exposed every frame_interval_ms from Open(), and
+    // Grab returns the next one to come (rendered when it is exposed); 0 returns frames as fast
+    // as they render.
     int frame_interval_ms = 0;
 
     // Returns an error naming the first invalid field ("camera.simulated.<field>: ..."), or Ok.
@@ -55,6 +57,8 @@ private:
     SyntheticScene scene_;
     bool open_ = false;
     std::uint64_t frames_rendered_ = 0;
+    std::chrono::steady_clock::time_point streaming_since_;  // the first frame's exposure
+    long long last_frame_tick_ = -1;                        // the last frame returned
     int pose_index_ = -1;  // counts distinct reported angles (the scene's moved_at_pose)
     double last_reported_deg_ = 0.0;
 };

@@ -287,6 +287,70 @@ TEST(CaptureConfig, ValidateNamesTheField) {
     c = CaptureConfig{};
     c.poses = 4;
     EXPECT_EQ(c.Angles(), (std::vector<double>{0.0, 90.0, 180.0, 270.0}));
+    c = CaptureConfig{};
+    c.order = "spiral";
+    ASSERT_FALSE(c.Validate());
+    EXPECT_NE(c.Validate().error().message.find("capture.order"), std::string::npos);
+    c = CaptureConfig{};
+    c.target_uncertainty_m = -0.001;
+    ASSERT_FALSE(c.Validate());
+    EXPECT_NE(c.Validate().error().message.find("capture.target_uncertainty_m"),
+              std::string::npos);
+}
+
+TEST(CaptureConfig, CoverageOrderSurroundsTheObjectFirstThenComesBack) {
+    CaptureConfig c;
+    c.poses = 18;
+    ASSERT_EQ(c.order, "coverage");
+    EXPECT_EQ(c.Angles(), (std::vector<double>{0, 60, 120, 180, 240, 300, 340, 320, 280, 260,
+                                               220, 200, 160, 140, 100, 80, 40, 20}));
+    c.poses = 36;  // every 6th first: still 60 degrees apart
+    const std::vector<double> a36 = c.Angles();
+    ASSERT_EQ(a36.size(), 36u);
+    EXPECT_EQ(std::vector<double>(a36.begin(), a36.begin() + 7),
+              (std::vector<double>{0, 60, 120, 180, 240, 300, 350}));
+    c.poses = 8;  // 45 degrees apart already: in order
+    EXPECT_EQ(c.Angles(), (std::vector<double>{0, 45, 90, 135, 180, 225, 270, 315}));
+    c.poses = 18;
+    c.order = "sequential";
+    EXPECT_EQ(c.Angles()[1], 20.0);
+    c.angles_deg = {0, 200, 100};  // explicit angles keep their order
+    c.order = "coverage";
+    EXPECT_EQ(c.Angles(), (std::vector<double>{0, 200, 100}));
+}
+
+TEST(CaptureLoop, StopsWhenAskedAndTellsThePlanFirst) {
+    SimulatorThread sim(FastSimulator());
+    auto table = Connect(sim.port());
+    ASSERT_TRUE(table);
+    SimulatedCamera camera(SmallCamera(), AngleOf(*table));
+    ASSERT_TRUE(camera.Open().ok());
+    CaptureStation station;
+    station.calibration = camera.Scene().recorded_calibration;
+    CaptureConfig config = QuickCapture(12);  // coverage: 0, 60, ... 300, then 330, 270, ...
+    std::vector<double> plan;
+    std::vector<int> asked;
+    CaptureCallbacks cb;
+    cb.on_plan = [&](const std::vector<double>& angles) { plan = angles; };
+    cb.stop = [&](int captured) {
+        asked.push_back(captured);
+        return captured == 6;
+    };
+    auto session = CaptureSession(*table, camera, config, station, cb);
+    ASSERT_TRUE(session.ok()) << session.error().message;
+    EXPECT_EQ(plan, (std::vector<double>{0, 60, 120, 180, 240, 300, 330, 270, 210, 150, 90, 30}));
+    ASSERT_EQ(session->poses.size(), 6u);
+    EXPECT_DOUBLE_EQ(session->poses[5].angle_deg, 300.0);
+    EXPECT_EQ(asked, (std::vector<int>{1, 2, 3, 4, 5, 6}));
+    EXPECT_NEAR(*table->CurrentAngleDeg(), 300.0, 0.5);  // it did not turn on
+
+    // The next parcel starts where the table stands, with no move, and the plan turns back.
+    cb.stop = nullptr;
+    config.poses = 3;
+    auto next = CaptureSession(*table, camera, config, station, cb);
+    ASSERT_TRUE(next.ok()) << next.error().message;
+    EXPECT_EQ(plan, (std::vector<double>{0, -120, -240}));
+    EXPECT_NEAR(*table->CurrentAngleDeg(), 60.0, 0.5);
 }
 
 TEST(SimulatedCamera, AngleErrorIsPerPoseAndRepeatable) {

@@ -25,10 +25,10 @@ Session Render(unsigned seed, int poses) {
 TEST(ViewStream, OneByOneMeasuresExactlyAsAllAtOnce) {
     const Session session = Render(21, 8);
     const MeasureConfig config;
-    ViewStream one(session, 8, config);
+    ViewStream one(session, session.PoseAnglesDeg(), config);
     std::vector<PreparedPose> prepared = PrepareSession(session, config);
     for (std::size_t i = 0; i < prepared.size(); ++i) {
-        one.Add(session.poses[i].angle_deg, std::move(prepared[i]));
+        one.Add(std::move(prepared[i]));
         EXPECT_EQ(one.Added(), static_cast<int>(i) + 1);
     }
     ASSERT_TRUE(one.Matches(session));
@@ -51,11 +51,11 @@ TEST(ViewStream, OneByOneMeasuresExactlyAsAllAtOnce) {
 TEST(ViewStream, AnUnusablePoseIsRefusedByNameWhateverFollows) {
     const Session session = Render(22, 4);
     const MeasureConfig config;
-    ViewStream stream(session, 4, config);
+    ViewStream stream(session, session.PoseAnglesDeg(), config);
     std::vector<PreparedPose> prepared = PrepareSession(session, config);
     prepared[2].error = "the camera returned no frames";
     for (std::size_t i = 0; i < prepared.size(); ++i) {
-        stream.Add(session.poses[i].angle_deg, std::move(prepared[i]));
+        stream.Add(std::move(prepared[i]));
     }
     const auto why = stream.Complete();
     ASSERT_TRUE(why.has_value());
@@ -72,9 +72,9 @@ TEST(ViewStream, APoseHidingTheTableWaitsForTheNextOnes) {
     for (float& z : prepared[0].depth.z_m) {
         if (z > 0.0f) z += 0.5f;
     }
-    ViewStream stream(session, 6, config);
+    ViewStream stream(session, session.PoseAnglesDeg(), config);
     for (std::size_t i = 0; i < prepared.size(); ++i) {
-        stream.Add(session.poses[i].angle_deg, std::move(prepared[i]));
+        stream.Add(std::move(prepared[i]));
     }
     EXPECT_FALSE(stream.Complete().has_value());
     EXPECT_GT(stream.table().points, 1000);
@@ -85,10 +85,10 @@ TEST(ViewStream, APoseHidingTheTableWaitsForTheNextOnes) {
 TEST(ViewStream, AStreamOfOtherPosesIsNotMeasuredAsTheSession) {
     const Session session = Render(24, 4);
     const MeasureConfig config;
-    ViewStream stream(session, 4, config);
+    ViewStream stream(session, session.PoseAnglesDeg(), config);
     std::vector<PreparedPose> prepared = PrepareSession(session, config);
     for (std::size_t i = 0; i < 3; ++i) {
-        stream.Add(session.poses[i].angle_deg, std::move(prepared[i]));
+        stream.Add(std::move(prepared[i]));
     }
     EXPECT_FALSE(stream.Matches(session));  // one pose short
     auto out = MeasureStreamed(session, stream, config, BoxMethod::kFootprint);

@@ -1,10 +1,13 @@
 // PosePreparer: poses handed over during a capture, in any order, are prepared and streamed in
 // pose order; poses never handed over are added at the end. Whatever arrived when, the stream
 // ends up with the views and alignments of the whole session fed at once, and measures to the
-// same numbers.
+// same numbers. With an uncertainty target it says when the poses so far determine the box.
 #include "daemon/service/pose_preparer.h"
 
 #include <gtest/gtest.h>
+
+#include <chrono>
+#include <thread>
 
 #include "drivers/sim/synthetic_station.h"
 #include "pipeline/measure_pipeline.h"
@@ -40,7 +43,7 @@ TEST(PosePreparer, StreamsEveryPoseInOrderWhateverArrivedWhen) {
     const Session session = SixPoses(9);
     ASSERT_EQ(session.poses.size(), 6u);
     const MeasureConfig config;
-    PosePreparer preparer(config, session, 6);
+    PosePreparer preparer(config, session, session.PoseAnglesDeg());
     // Poses 0, 4, 1 arrive (4 before its turn); the others never do.
     for (std::size_t i : {0, 4, 1}) Hand(preparer, session, i);
     ViewStream& stream = preparer.Finish(session);
@@ -60,8 +63,10 @@ TEST(PosePreparer, StartsOverWhenTheCaptureIsNotThePlan) {
     const Session session = SixPoses(10);
     ASSERT_EQ(session.poses.size(), 6u);
     const MeasureConfig config;
-    PosePreparer preparer(config, session, 6);
-    // Pose 1 was streamed at another angle than the session records.
+    // The plan had pose 1 at another angle than the session records.
+    std::vector<double> plan = session.PoseAnglesDeg();
+    plan[1] += 7.0;
+    PosePreparer preparer(config, session, plan);
     Hand(preparer, session, 0);
     Hand(preparer, session, 1, 7.0);
     ViewStream& stream = preparer.Finish(session);
@@ -76,17 +81,101 @@ TEST(PosePreparer, StopsCleanlyWithWorkQueued) {
     SyntheticStationConfig c;
     auto session = RenderSyntheticSession(c, 2, 1);
     ASSERT_TRUE(session.ok());
-    auto preparer = std::make_unique<PosePreparer>(MeasureConfig{}, *session, 2);
+    auto preparer = std::make_unique<PosePreparer>(MeasureConfig{}, *session,
+                                                   session->PoseAnglesDeg());
     for (int k = 0; k < 20; ++k) {
         preparer->Add(static_cast<std::size_t>(k % 2), 0.0, session->poses[0].frames,
                       session->camera.depth_unit_m);
     }
     preparer.reset();  // an aborted measurement: must neither hang nor crash
     // Nothing handed over: Finish adds every pose itself.
-    PosePreparer idle{MeasureConfig{}, *session, 2};
+    PosePreparer idle{MeasureConfig{}, *session, session->PoseAnglesDeg()};
     ViewStream& stream = idle.Finish(*session);
     EXPECT_EQ(stream.Added(), 2);
     EXPECT_TRUE(stream.Matches(*session));
+}
+
+TEST(WidestGapDeg, IsTheLargestTurnBetweenNeighbouringViews) {
+    EXPECT_DOUBLE_EQ(WidestGapDeg({0.0}), 360.0);
+    EXPECT_DOUBLE_EQ(WidestGapDeg({0.0, 180.0}), 180.0);
+    EXPECT_DOUBLE_EQ(WidestGapDeg({0.0, 60.0, 120.0, 180.0, 240.0}), 120.0);  // 240 back to 360
+    EXPECT_DOUBLE_EQ(WidestGapDeg({0.0, -60.0, -120.0, -180.0, -240.0, -300.0}), 60.0);
+    EXPECT_DOUBLE_EQ(WidestGapDeg({350.0, 10.0, 370.0}), 340.0);  // 370 is 10 again
+}
+
+// Returns a simulated session of a 400 x 300 x 250 box whose poses come in the coverage
+// order of an 18-pose budget: every third pose first (0, 60, ... 300), then the rest backwards.
+Session CoverageOrdered() {
+    SyntheticStationConfig c;
+    c.seed = 31;
+    c.box.length_m = 0.4;
+    c.box.width_m = 0.3;
+    c.box.height_m = 0.25;
+    c.box.yaw_deg = 20.0;
+    auto session = RenderSyntheticSession(
+        c, {0, 60, 120, 180, 240, 300, 340, 320, 280, 260, 220, 200, 160, 140, 100, 80, 40, 20},
+        2);
+    EXPECT_TRUE(session.ok());
+    return session.ok() ? *session : Session{};
+}
+
+// Waits up to 20 s for the worker to stream `poses` poses and measure them.
+bool WaitDetermined(const PosePreparer& preparer) {
+    for (int i = 0; i < 400 && !preparer.Determined(); ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return preparer.Determined();
+}
+
+TEST(PosePreparer, TheBoxIsDeterminedOnlyOnceTheViewsSurroundIt) {
+    const Session session = CoverageOrdered();
+    ASSERT_EQ(session.poses.size(), 18u);
+    const MeasureConfig config;
+    PosePreparer preparer(config, session, session.PoseAnglesDeg(), 0.005);
+    // Five poses (0 to 240 degrees) leave a 120-degree gap: a face may not have been seen.
+    for (std::size_t i = 0; i < 5; ++i) Hand(preparer, session, i);
+    for (int i = 0; i < 100 && preparer.Streamed() < 5; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    ASSERT_EQ(preparer.Streamed(), 5);
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    EXPECT_FALSE(preparer.Determined());
+    // The sixth closes the turn: within a 5 mm target, the box is known.
+    Hand(preparer, session, 5);
+    ASSERT_TRUE(WaitDetermined(preparer));
+    // The capture stops there: the stream ends with the six poses and measures them exactly
+    // as the six-pose session measured on its own.
+    Session six = session;
+    six.poses.resize(6);
+    ViewStream& stream = preparer.Finish(six);
+    EXPECT_TRUE(stream.Matches(six));
+    auto streamed = MeasureStreamed(six, stream, config, BoxMethod::kFootprint);
+    ASSERT_TRUE(streamed.ok());
+    const MeasurementResult want = AllAtOnce(six, config);
+    ASSERT_EQ(streamed->result.status, MeasurementStatus::kOk);
+    EXPECT_EQ(streamed->result.dimensions->length_m, want.dimensions->length_m);
+    EXPECT_EQ(streamed->result.dimensions->width_m, want.dimensions->width_m);
+    EXPECT_NEAR(streamed->result.dimensions->length_m, 0.4, 0.002);
+    EXPECT_NEAR(streamed->result.dimensions->width_m, 0.3, 0.002);
+}
+
+TEST(PosePreparer, AnUnreachableTargetTakesEveryPose) {
+    const Session session = CoverageOrdered();
+    const MeasureConfig config;
+    PosePreparer preparer(config, session, session.PoseAnglesDeg(), 1e-6);
+    for (std::size_t i = 0; i < 8; ++i) Hand(preparer, session, i);
+    for (int i = 0; i < 200 && preparer.Streamed() < 8; ++i) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    EXPECT_FALSE(preparer.Determined());
+    ViewStream& stream = preparer.Finish(session);  // the rest never came: added here
+    EXPECT_TRUE(stream.Matches(session));
+    auto streamed = MeasureStreamed(session, stream, config, BoxMethod::kFootprint);
+    ASSERT_TRUE(streamed.ok());
+    // Captured in coverage order, measured as the same poses around the turn in order.
+    EXPECT_NEAR(streamed->result.dimensions->length_m, AllAtOnce(session, config).dimensions->length_m,
+                1e-9);
 }
 
 }  // namespace
