@@ -9,6 +9,11 @@ namespace boxd::envelope {
 
 namespace {
 
+// A side's support that falls short of the readings' reach that way by more than this share
+// of the object's extent across was never faced by a view: a seen side stands within the
+// noise (millimetres) of that reach, an unseen one about the object's whole size inside it.
+constexpr double kUnseenShare = 0.25;
+
 // The outer layer's largest bound in direction (cos φ, sin φ) and in the opposite one, over
 // cells of (position across the direction, height).
 struct Support {
@@ -134,8 +139,20 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma,
     const std::vector<Eigen::Vector3f>& pts = surface.points;
     if (pts.empty()) return Error{ErrorCode::kInsufficientData, "no surface above the table"};
     const double radius = surface.radius, top = surface.top;
-    auto width = [&](double phi, Support* s) {
+    // A side no view faced has no facing surface: its "support" would be whatever faces that
+    // way farther in (the far side's inside, a panel's back), well inside the readings of the
+    // top or the other sides that reach out there. Such a direction bounds nothing.
+    auto width = [&](double phi, Support* s) -> double {
         *s = SupportAlong(pts, phi, sigma, radius, top, config);
+        const Eigen::Vector2f u(static_cast<float>(std::cos(phi)), static_cast<float>(std::sin(phi)));
+        double reach_f = -INFINITY, reach_b = -INFINITY;
+        for (const Eigen::Vector3f& p : pts) {
+            const double d = u.dot(p.head<2>());
+            reach_f = std::max(reach_f, d);
+            reach_b = std::max(reach_b, -d);
+        }
+        const double slack = kUnseenShare * (reach_f + reach_b);
+        if (s->forward < reach_f - slack || s->backward < reach_b - slack) return INFINITY;
         return s->forward + s->backward;
     };
     // Every direction, then finer about the least area.
@@ -143,6 +160,12 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma,
     std::vector<Support> coarse(static_cast<std::size_t>(n));
     std::vector<double> w(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i) w[i] = width(M_PI * i / n, &coarse[i]);
+    // An unseen side leaves the object unbounded there: a bulge or a flap could stand out
+    // anywhere on it, and every rectangle would be a guess.
+    if (std::any_of(w.begin(), w.end(), [](double x) { return !std::isfinite(x); })) {
+        return Error{ErrorCode::kInsufficientData,
+                     "a side of the object was never seen: too few views around it to bound it"};
+    }
     int best = 0;
     for (int i = 1; i < n; ++i) {
         if (w[i] * w[(i + n / 2) % n] < w[best] * w[(best + n / 2) % n]) best = i;
@@ -161,7 +184,8 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma,
         }
     }
     if (!std::isfinite(best_area)) {
-        return Error{ErrorCode::kInsufficientData, "too few surface cells to bound the object"};
+        return Error{ErrorCode::kInsufficientData,
+                     "a side of the object was never seen: too few views around it to bound it"};
     }
     EnclosingCuboid c;
     const Eigen::Vector2d u(std::cos(best_phi), std::sin(best_phi)), v(-u.y(), u.x());

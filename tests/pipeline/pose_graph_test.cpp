@@ -17,9 +17,11 @@ struct Ring {
     PoseGraph graph;
 };
 
-Ring MakeRing(int n, Eigen::Vector2d center, unsigned seed, double edge_sigma_m = 0.0002) {
+Ring MakeRing(int n, Eigen::Vector2d center, unsigned seed, double edge_sigma_m = 0.0002,
+              double angle_error_deg = 0.3) {
     std::mt19937 rng(seed);
-    std::normal_distribution<double> angle_err(0.0, 0.3 * kDeg), t_noise(0.0, edge_sigma_m),
+    std::normal_distribution<double> angle_err(0.0, angle_error_deg * kDeg),
+        t_noise(0.0, edge_sigma_m),
         yaw_noise(0.0, 0.02 * kDeg);
     Ring ring;
     for (int k = 0; k < n; ++k) {
@@ -150,6 +152,23 @@ TEST(PoseCovariance, IsWithinAFactorOfTheTrueScatter) {
     const double ratio = std::sqrt(predicted / squared_error);
     EXPECT_GT(ratio, 0.5);
     EXPECT_LT(ratio, 2.0);
+}
+
+TEST(PoseCovariance, TheTablesAngleErrorDoesNotWidenWhereTheViewsSit) {
+    // The same ring on a table that misses its angles by 0.3 and by 3 degrees: the yaws' prior
+    // fits ten times worse, the translations' no worse. The views' translations lose some
+    // certainty (the yaws hold them less), but do not follow the angle error as they did when
+    // one variance factor scaled the prior's yaws and translations together (ten times wider).
+    PoseGraphConfig config;
+    double sigma_t[2] = {};
+    for (int i = 0; i < 2; ++i) {
+        Ring ring = MakeRing(18, {0.002, 0.001}, 6, 0.0002, i == 0 ? 0.3 : 3.0);
+        ASSERT_TRUE(OptimizePoseGraph(ring.graph, config).ok());
+        const Eigen::MatrixXd cov = PoseCovariance(ring.graph, config);
+        for (int k = 1; k < 18; ++k) sigma_t[i] += std::sqrt(cov(3 * k, 3 * k)) / 17.0;
+    }
+    EXPECT_GT(sigma_t[0], 0.0);
+    EXPECT_LT(sigma_t[1], 6.0 * sigma_t[0]) << sigma_t[0] << " " << sigma_t[1];
 }
 
 TEST(PoseCovariance, TurntableModelAloneTakesThePriorsSigmas) {
