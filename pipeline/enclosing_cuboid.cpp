@@ -142,8 +142,13 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
         // other dimension... the face's own span is what a bulge is measured against.
         const std::array<double, 5> span = {fit.width_m, fit.width_m, fit.length_m, fit.length_m,
                                             std::min(fit.length_m, fit.width_m)};
+        c.flatness = 0.0;
         for (std::size_t f = 0; f < 5; ++f) {
             c.max_relative_excess = std::max(c.max_relative_excess, faces[f].excess_m / span[f]);
+            // A face not told (NaN) leaves the whole not told.
+            c.flatness = std::isnan(faces[f].flatness) || std::isnan(c.flatness)
+                             ? std::numeric_limits<double>::quiet_NaN()
+                             : std::max(c.flatness, faces[f].flatness);
         }
         // A face's position: the spread of its offset over the views, and when it stands out,
         // the cell that says how far.

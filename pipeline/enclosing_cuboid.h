@@ -23,6 +23,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <limits>
 
 #include "pipeline/box_fit.h"
 #include "pipeline/fusion.h"
@@ -75,6 +76,9 @@ struct EnclosingCuboid {
     double fill = 1.0;     // footprint area over rectangle area
     double top_cover = 1.0;  // share of the footprint's cells whose highest reading is the top's
     double max_relative_excess = 0.0;  // largest face excess over the box size across it
+    // The least flat face's flatness (FaceResult::flatness): NaN unless the face fit ran and
+    // every face had enough cells seen twice to tell.
+    double flatness = std::numeric_limits<double>::quiet_NaN();
     std::array<double, 5> excess_m{};  // +u, -u, +v, -v sides and the top, beyond the faces
     std::array<double, 3> sigma_m{};   // 1-sigma of length, width, height from the data
 };

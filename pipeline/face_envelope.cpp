@@ -10,6 +10,9 @@ namespace boxd::envelope {
 
 namespace {
 
+// A face is judged flat or not from at least this many cells seen by two views or more.
+constexpr int kMinFlatnessCells = 10;
+
 // One face's cells, each with its points' offsets from the face plane kept per view: the views
 // are the independent samples (a view's neighbouring readings share its registration error and
 // its sensor's disparity steps, so its points are not).
@@ -53,6 +56,19 @@ struct FaceCells {
             if (v.n >= 4 * config.min_cell_points) offsets.Add(v.Mean());
         }
         FaceResult out;
+        // Flatness: the cells seen by two views or more, their means about the plane against
+        // their own standard errors (chi-square per cell: about 1 for a flat face).
+        if (dof >= 10) {
+            double chi2 = 0.0;
+            int tested = 0;
+            for (const auto& [cell, st] : cells) {
+                if (st.n < 2) continue;
+                const double r = st.Mean() / (spread / std::sqrt(st.n));
+                chi2 += r * r;
+                ++tested;
+            }
+            if (tested >= kMinFlatnessCells) out.flatness = chi2 / tested;
+        }
         out.view_spread_m = offsets.n >= 2 ? offsets.StdError() * std::sqrt(offsets.n) : 0.0;
         out.offset_se_m = offsets.n >= 2
                               ? offsets.StdError()

@@ -4,6 +4,7 @@
 // views. The cuboid half of the enclosing cuboid (enclosing_cuboid.h).
 
 #include <array>
+#include <limits>
 
 #include "pipeline/box_fit.h"
 #include "pipeline/enclosing_cuboid.h"
@@ -16,6 +17,10 @@ struct FaceResult {
     double excess_se_m = 0.0;    // standard error of the cell that set the excess
     double offset_se_m = 0.0;    // standard error of the face plane's offset, from the views
     double view_spread_m = 0.0;  // standard deviation of the plane's offset between the views
+    // The face's cells (those two views or more saw) about its plane: the mean square of
+    // their offsets over their standard errors, about 1 for a flat face, far more for a
+    // bulge, a strap or a label; NaN when too few cells were seen twice to tell.
+    double flatness = std::numeric_limits<double>::quiet_NaN();
 };
 
 // The excess of the 4 side faces and the top of `box` over their fitted planes, and the

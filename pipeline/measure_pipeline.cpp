@@ -129,6 +129,7 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream,
         quality.top_cover = cuboid->top_cover;
         quality.face_excess_ratio = cuboid->max_relative_excess;
         quality.cuboid_assumed = cuboid->assumed;
+        if (std::isfinite(cuboid->flatness)) quality.face_flatness = cuboid->flatness;
         // The faces' own scatter, and what the registration may still have moved them by.
         const auto moved = RegistrationSigma(fit.fused, *cuboid, registered->poses,
                                              registered->pose_covariance);

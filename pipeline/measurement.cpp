@@ -110,6 +110,9 @@ json ToJson(const MeasurementResult& m) {
     }
     if (m.quality.top_cover) j["quality"]["top_cover"] = Round(*m.quality.top_cover, 1e-3);
     if (m.quality.cuboid_assumed) j["quality"]["cuboid_assumed"] = true;
+    if (m.quality.face_flatness) {
+        j["quality"]["face_flatness"] = Round(*m.quality.face_flatness, 1e-2);
+    }
     if (!m.quality.stop_reason.empty()) j["quality"]["stop_reason"] = m.quality.stop_reason;
     if (m.quality.face_excess_ratio) {
         j["quality"]["face_excess_ratio"] = Round(*m.quality.face_excess_ratio, 1e-4);

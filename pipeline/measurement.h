@@ -50,6 +50,10 @@ struct MeasurementQuality {
     std::optional<double> footprint_fill;
     std::optional<double> top_cover;
     std::optional<double> face_excess_ratio;
+    // The least flat face's cells about its plane (chi-square per cell, about 1 when flat);
+    // absent unless every face had enough cells seen by two views to tell. A capture stops
+    // early only for a box whose faces are all told flat.
+    std::optional<double> face_flatness;
     // A single view: the faces it does not show were assumed to make a cuboid.
     bool cuboid_assumed = false;
     // Why a capture stopped turning: "target_uncertainty" (every dimension's bound within the

@@ -107,7 +107,12 @@ void PosePreparer::TryDetermine() {
     auto out = MeasureStreamed(session, *so_far, config_, method_, SteadyClockMs());
     if (!out) return done(true, INFINITY, std::nullopt);
     const MeasurementResult& r = out->result;
-    const bool cuboid = r.status == MeasurementStatus::kOk && r.shape == "cuboid" && r.uncertainty_m;
+    // Only a cuboid whose every face was told flat: a face's envelope is blind where too few
+    // views saw it (few poses leave its cells one view each), and a bulge or a strap it cannot
+    // see would be measured at the mean plane with a confident bound.
+    const bool cuboid = r.status == MeasurementStatus::kOk && r.shape == "cuboid" &&
+                        r.uncertainty_m && r.quality.face_flatness &&
+                        *r.quality.face_flatness <= kFlatFaces;
     const double worst = cuboid ? std::max({r.uncertainty_m->length_m, r.uncertainty_m->width_m,
                                             r.uncertainty_m->height_m})
                                 : INFINITY;

@@ -30,6 +30,11 @@ namespace boxd {
 // The widest gap between neighbouring views around the turn (degrees) that still counts as
 // surrounding the object.
 inline constexpr double kSurroundGapDeg = 90.0;
+// The largest quality.face_flatness (chi-square per cell) that counts as flat faces: several
+// hundred cells of a flat face give 1 within a few tenths (cells of a real box, whose views
+// disagree by the registration's tenths of a millimetre, up to about 2); a 3 mm bulge or a
+// 2 mm strap gives 4 to 50.
+inline constexpr double kFlatFaces = 2.5;
 // A measurement so far whose worst bound came within this factor of the target makes the
 // capture wait for the next one before it turns on.
 inline constexpr double kCloseFactor = 2.0;

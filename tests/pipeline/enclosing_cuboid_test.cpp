@@ -229,6 +229,10 @@ TEST(FitEnclosingCuboid, IdealBoxIsTheBoxFitWithNoExcess) {
     EXPECT_GT(c.fill, 0.98);
     EXPECT_LE(c.fill, 1.0);
     EXPECT_GT(c.top_cover, 0.95);
+    // Every face told (cells seen by two views) and flat: its cells scatter about the plane as
+    // their standard errors say (chi-square per cell about 1; the views' 0.3 mm shifts add some).
+    ASSERT_TRUE(std::isfinite(c.flatness));
+    EXPECT_LT(c.flatness, 2.0);
     // The data's own 1-sigma per dimension: of the order of the views' shifts, not centimetres.
     for (double s : c.sigma_m) {
         EXPECT_GT(s, 0.0);
@@ -259,6 +263,8 @@ void ExpectBulgeFound(double agreement_m) {
     EXPECT_NEAR(c.length_m, l, kFaceTol);
     EXPECT_NEAR(c.height_m, h, kFaceTol);
     EXPECT_LT(c.max_relative_excess, EnvelopeConfig{}.max_relative_excess);
+    // The domes' cells stand far out of their standard errors: the faces are told not flat.
+    EXPECT_GT(c.flatness, 4.0);
 }
 
 TEST(FitEnclosingCuboid, BulgingLongSidesWidenTheBoxByTheBulge) {

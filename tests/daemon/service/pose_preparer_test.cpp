@@ -105,9 +105,10 @@ TEST(WidestGapDeg, IsTheLargestTurnBetweenNeighbouringViews) {
 
 // Returns a simulated session of a 400 x 300 x 250 box whose poses come in the coverage
 // order of an 18-pose budget: every third pose first (0, 60, ... 300), then the rest backwards.
-Session CoverageOrdered() {
+Session CoverageOrdered(double bulge_m = 0.0) {
     SyntheticStationConfig c;
     c.seed = 31;
+    c.box.bulge_m = bulge_m;
     c.box.length_m = 0.4;
     c.box.width_m = 0.3;
     c.box.height_m = 0.25;
@@ -119,44 +120,63 @@ Session CoverageOrdered() {
     return session.ok() ? *session : Session{};
 }
 
-// Waits up to 20 s for the worker to stream `poses` poses and measure them.
-bool WaitDetermined(const PosePreparer& preparer) {
-    for (int i = 0; i < 400 && !preparer.Determined(); ++i) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    return preparer.Determined();
-}
-
 TEST(PosePreparer, TheBoxIsDeterminedOnlyOnceTheViewsSurroundIt) {
     const Session session = CoverageOrdered();
     ASSERT_EQ(session.poses.size(), 18u);
     const MeasureConfig config;
     PosePreparer preparer(config, session, session.PoseAnglesDeg(), 0.005);
-    // Five poses (0 to 240 degrees) leave a 120-degree gap: a face may not have been seen.
-    for (std::size_t i = 0; i < 5; ++i) Hand(preparer, session, i);
-    for (int i = 0; i < 100 && preparer.Streamed() < 5; ++i) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    // The capture asks after each pose; before the sixth (0 to 240 degrees leave a 120-degree
+    // gap) a face may not have been seen, and the answer is no whatever the bounds.
+    int stopped_at = 0;
+    for (std::size_t i = 0; i < session.poses.size() && stopped_at == 0; ++i) {
+        Hand(preparer, session, i);
+        const int captured = static_cast<int>(i) + 1;
+        // The table's turn to the next pose: time for the worker to take this one in.
+        for (int k = 0; k < 100 && preparer.Streamed() < captured; ++k) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(200));
+        const bool stop = preparer.ShouldStop(captured);
+        if (captured < 6) EXPECT_FALSE(stop) << "after pose " << captured;
+        if (stop) stopped_at = captured;
     }
-    ASSERT_EQ(preparer.Streamed(), 5);
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    EXPECT_FALSE(preparer.Determined());
-    // The sixth closes the turn: within a 5 mm target, the box is known.
-    Hand(preparer, session, 5);
-    ASSERT_TRUE(WaitDetermined(preparer));
-    // The capture stops there: the stream ends with the six poses and measures them exactly
-    // as the six-pose session measured on its own.
-    Session six = session;
-    six.poses.resize(6);
-    ViewStream& stream = preparer.Finish(six);
-    EXPECT_TRUE(stream.Matches(six));
-    auto streamed = MeasureStreamed(six, stream, config, BoxMethod::kFootprint);
-    ASSERT_TRUE(streamed.ok());
-    const MeasurementResult want = AllAtOnce(six, config);
-    ASSERT_EQ(streamed->result.status, MeasurementStatus::kOk);
-    EXPECT_EQ(streamed->result.dimensions->length_m, want.dimensions->length_m);
-    EXPECT_EQ(streamed->result.dimensions->width_m, want.dimensions->width_m);
-    EXPECT_NEAR(streamed->result.dimensions->length_m, 0.4, 0.002);
-    EXPECT_NEAR(streamed->result.dimensions->width_m, 0.3, 0.002);
+    ASSERT_GE(stopped_at, 6) << "an ideal box within a 5 mm target was never determined";
+    EXPECT_TRUE(preparer.Determined());
+    // The capture stops there: the measurement that determined it is of exactly those poses,
+    // and it is the one the session of those poses measures on its own.
+    Session taken = session;
+    taken.poses.resize(static_cast<std::size_t>(stopped_at));
+    auto determined = preparer.TakeDetermined(taken);
+    ASSERT_TRUE(determined.has_value());
+    const MeasurementResult want = AllAtOnce(taken, config);
+    ASSERT_EQ(determined->result.status, MeasurementStatus::kOk);
+    EXPECT_EQ(determined->result.dimensions->length_m, want.dimensions->length_m);
+    EXPECT_EQ(determined->result.dimensions->width_m, want.dimensions->width_m);
+    EXPECT_NEAR(determined->result.dimensions->length_m, 0.4, 0.002);
+    EXPECT_NEAR(determined->result.dimensions->width_m, 0.3, 0.002);
+    EXPECT_NEAR(determined->result.dimensions->height_m, 0.25, 0.002);
+    EXPECT_LE(*determined->result.quality.face_flatness, kFlatFaces);
+    // The stream, for a result measured again, ends with those poses too.
+    ViewStream& stream = preparer.Finish(taken);
+    EXPECT_TRUE(stream.Matches(taken));
+}
+
+TEST(PosePreparer, ABulgingCartonIsNotDeterminedByItsMeanPlanes) {
+    // 4 mm bulges: the faces' cells stand out of their planes, so however small the bounds of
+    // the planes, the poses so far never determine it (a generous 5 mm target): a bulge the
+    // envelope cannot yet place would be billed short.
+    const Session session = CoverageOrdered(0.004);
+    const MeasureConfig config;
+    PosePreparer preparer(config, session, session.PoseAnglesDeg(), 0.005);
+    for (std::size_t i = 0; i < session.poses.size(); ++i) {
+        Hand(preparer, session, i);
+        EXPECT_FALSE(preparer.ShouldStop(static_cast<int>(i) + 1)) << "after pose " << i + 1;
+    }
+    ViewStream& stream = preparer.Finish(session);
+    auto out = MeasureStreamed(session, stream, config, BoxMethod::kFootprint);
+    ASSERT_TRUE(out.ok());
+    ASSERT_TRUE(out->result.quality.face_flatness.has_value());
+    EXPECT_GT(*out->result.quality.face_flatness, kFlatFaces);
 }
 
 TEST(PosePreparer, AnUnreachableTargetTakesEveryPose) {
