@@ -86,6 +86,24 @@ AngleSource AngleOf(Turntable& table) {
     return [&table] { return table.CurrentAngleDeg(); };
 }
 
+// A fast simulated table served on a thread, the small simulated camera looking at it, and the
+// station calibration its scene records.
+struct Rig {
+    explicit Rig(double speed_dps = 720.0)
+        : table(Connect(sim.port(), speed_dps)),
+          camera(SmallCamera(), [this]() -> Result<double> {
+              if (!table) return Error{ErrorCode::kTurntableError, "no table"};
+              return table->CurrentAngleDeg();
+          }) {
+        EXPECT_TRUE(camera.Open().ok());
+        station.calibration = camera.Scene().recorded_calibration;
+    }
+    SimulatorThread sim{FastSimulator()};
+    std::unique_ptr<Turntable> table;
+    SimulatedCamera camera;
+    CaptureStation station;
+};
+
 CaptureConfig QuickCapture(int poses) {
     CaptureConfig c;
     c.poses = poses;
@@ -97,14 +115,9 @@ CaptureConfig QuickCapture(int poses) {
 }
 
 TEST(CaptureLoop, CapturesEveryPoseWithRawFrames) {
-    SimulatorThread sim(FastSimulator());
-    auto table = Connect(sim.port());
-    ASSERT_TRUE(table);
-    SimulatedCamera camera(SmallCamera(), AngleOf(*table));
-    ASSERT_TRUE(camera.Open().ok());
-
-    CaptureStation station;
-    station.calibration = camera.Scene().recorded_calibration;
+    Rig rig;
+    ASSERT_TRUE(rig.table);
+    auto& [sim, table, camera, station] = rig;
     std::vector<std::pair<int, int>> progress;
     std::vector<std::size_t> handed_over;
     CaptureCallbacks cb;
@@ -141,13 +154,9 @@ TEST(CaptureLoop, CapturesEveryPoseWithRawFrames) {
 }
 
 TEST(CaptureLoop, AlternateSweepsStartWhereTheTableStandsAndTurnBack) {
-    SimulatorThread sim(FastSimulator());
-    auto table = Connect(sim.port());
-    ASSERT_TRUE(table);
-    SimulatedCamera camera(SmallCamera(), AngleOf(*table));
-    ASSERT_TRUE(camera.Open().ok());
-    CaptureStation station;
-    station.calibration = camera.Scene().recorded_calibration;
+    Rig rig;
+    ASSERT_TRUE(rig.table);
+    auto& [sim, table, camera, station] = rig;
     CaptureConfig config = QuickCapture(4);
     ASSERT_EQ(config.sweep, "alternate");
 
@@ -320,13 +329,9 @@ TEST(CaptureConfig, CoverageOrderSurroundsTheObjectFirstThenComesBack) {
 }
 
 TEST(CaptureLoop, StopsWhenAskedAndTellsThePlanFirst) {
-    SimulatorThread sim(FastSimulator());
-    auto table = Connect(sim.port());
-    ASSERT_TRUE(table);
-    SimulatedCamera camera(SmallCamera(), AngleOf(*table));
-    ASSERT_TRUE(camera.Open().ok());
-    CaptureStation station;
-    station.calibration = camera.Scene().recorded_calibration;
+    Rig rig;
+    ASSERT_TRUE(rig.table);
+    auto& [sim, table, camera, station] = rig;
     CaptureConfig config = QuickCapture(12);  // coverage: 0, 60, ... 300, then 330, 270, ...
     std::vector<double> plan;
     std::vector<int> asked;
