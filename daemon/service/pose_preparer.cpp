@@ -153,6 +153,11 @@ std::optional<MeasureOutput> PosePreparer::TakeDetermined(const Session& session
 
 int PosePreparer::Streamed() const { return streamed_.load(); }
 
+int PosePreparer::Measured() const {
+    std::lock_guard lock(mutex_);
+    return measured_;
+}
+
 ViewStream& PosePreparer::Finish(const Session& session) {
     // The worker finishes the pose in hand; the rest is prepared here on all threads (a source
     // faster than the stream, like a replay, leaves a backlog).

@@ -79,6 +79,10 @@ public:
     // poses of the plan (a capture that stopped early) ends the plan there.
     ViewStream& Finish(const Session& session);
 
+    // Returns how many poses the last measurement so far had (or was passed over at, before
+    // the poses surround the object); 0 before the first.
+    int Measured() const;
+
     // Returns how many poses the worker has streamed so far, and how many the plan has.
     int Streamed() const;
     int Planned() const { return planned_; }

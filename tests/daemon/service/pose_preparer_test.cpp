@@ -131,11 +131,11 @@ TEST(PosePreparer, TheBoxIsDeterminedOnlyOnceTheViewsSurroundIt) {
     for (std::size_t i = 0; i < session.poses.size() && stopped_at == 0; ++i) {
         Hand(preparer, session, i);
         const int captured = static_cast<int>(i) + 1;
-        // The table's turn to the next pose: time for the worker to take this one in.
-        for (int k = 0; k < 100 && preparer.Streamed() < captured; ++k) {
+        // The table's turn to the next pose: time for the worker to take this one in and
+        // measure the poses so far (up to 30 s: sanitized builds are slow).
+        for (int k = 0; k < 1500 && preparer.Measured() < captured; ++k) {
             std::this_thread::sleep_for(std::chrono::milliseconds(20));
         }
-        std::this_thread::sleep_for(std::chrono::milliseconds(200));
         const bool stop = preparer.ShouldStop(captured);
         if (captured < 6) EXPECT_FALSE(stop) << "after pose " << captured;
         if (stop) stopped_at = captured;
