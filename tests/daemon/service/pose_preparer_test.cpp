@@ -137,7 +137,9 @@ TEST(PosePreparer, TheBoxIsDeterminedOnlyOnceTheViewsSurroundIt) {
             std::this_thread::sleep_for(std::chrono::milliseconds(20));
         }
         const bool stop = preparer.ShouldStop(captured);
-        if (captured < 6) EXPECT_FALSE(stop) << "after pose " << captured;
+        if (captured < 6) {
+            EXPECT_FALSE(stop) << "after pose " << captured;
+        }
         if (stop) stopped_at = captured;
     }
     ASSERT_GE(stopped_at, 6) << "an ideal box within a 5 mm target was never determined";
