@@ -189,15 +189,14 @@ Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
     };
 
     const Sweep sweep = PlanSweep(turntable, config, angles);
-    if (callbacks.on_plan) {
-        std::vector<double> plan;
-        for (double a : angles) plan.push_back(sweep.sign * (a - angles[0]));
-        callbacks.on_plan(plan);
-    }
+    // Each pose's angle as the session records it: from the first pose, signed by the sweep.
+    std::vector<double> plan;
+    for (double a : angles) plan.push_back(sweep.sign * (a - angles[0]));
+    if (callbacks.on_plan) callbacks.on_plan(plan);
     for (int k = 0; k < n; ++k) {
         if (callbacks.on_progress) callbacks.on_progress(k, n);
         if (Cancelled(callbacks)) return cancelled(k);
-        const double relative = sweep.sign * (angles[k] - angles[0]);
+        const double relative = plan[static_cast<std::size_t>(k)];
         // A table already standing at the first pose (where the last sweep ended) needs
         // neither a move nor time to settle.
         if (k == 0 && StandsAt(turntable, sweep.start_deg)) {

@@ -10,6 +10,13 @@ double TurntableAngleRad(double angle_deg, TurntableDirection direction) {
     return direction == TurntableDirection::kCcw ? rad : -rad;
 }
 
+std::vector<double> TurntableAnglesRad(const std::vector<double>& angles_deg,
+                                       TurntableDirection direction) {
+    std::vector<double> out;
+    for (double a : angles_deg) out.push_back(TurntableAngleRad(a, direction));
+    return out;
+}
+
 double Session::PoseAngleRad(std::size_t i) const {
     return TurntableAngleRad(poses.at(i).angle_deg, direction);
 }
@@ -21,9 +28,7 @@ std::string SessionFramePath(std::size_t pose, std::size_t frame) {
 }
 
 std::vector<double> Session::PoseAnglesRad() const {
-    std::vector<double> angles(poses.size());
-    for (std::size_t i = 0; i < poses.size(); ++i) angles[i] = PoseAngleRad(i);
-    return angles;
+    return TurntableAnglesRad(PoseAnglesDeg(), direction);
 }
 
 std::vector<double> Session::PoseAnglesDeg() const {

@@ -32,6 +32,9 @@ struct SessionPose {
 // Returns a commanded turntable angle in radians, signed so that positive is a counter-clockwise
 // turn about the table axis (a clockwise table's angles are negated).
 double TurntableAngleRad(double angle_deg, TurntableDirection direction);
+// Returns TurntableAngleRad of each of `angles_deg`, in order.
+std::vector<double> TurntableAnglesRad(const std::vector<double>& angles_deg,
+                                       TurntableDirection direction);
 
 struct Session {
     std::string source = "synthetic";

@@ -29,21 +29,11 @@ std::vector<Eigen::Vector3d> EvenSubsample(std::vector<Eigen::Vector3d> pts, std
 
 }  // namespace
 
-namespace {
-
-std::vector<double> TableAnglesRad(const std::vector<double>& degrees, TurntableDirection dir) {
-    std::vector<double> out;
-    for (double d : degrees) out.push_back(TurntableAngleRad(d, dir));
-    return out;
-}
-
-}  // namespace
-
 ViewStream::ViewStream(const Session& header, std::vector<double> plan_deg, MeasureConfig config,
                        MonotonicMs clock)
     : config_(std::move(config)),
       plan_deg_(std::move(plan_deg)),
-      plan_rad_(TableAnglesRad(plan_deg_, header.direction)),
+      plan_rad_(TurntableAnglesRad(plan_deg_, header.direction)),
       order_(plan_rad_),
       clock_(std::move(clock)) {
     header_.camera = header.camera;
@@ -150,12 +140,10 @@ void ViewStream::SegmentInto(std::size_t k, const DepthMap& depth) {
 void ViewStream::Add(PreparedPose pose) {
     std::vector<PreparedPose> one;
     one.push_back(std::move(pose));
-    AddPoses(std::move(one));
+    AddAll(std::move(one));
 }
 
-void ViewStream::AddAll(std::vector<PreparedPose> poses) { AddPoses(std::move(poses)); }
-
-void ViewStream::AddPoses(std::vector<PreparedPose> poses) {
+void ViewStream::AddAll(std::vector<PreparedPose> poses) {
     const double t0 = Now();
     const int first = Added();
     const int n = std::min(Planned() - first, static_cast<int>(poses.size()));

@@ -75,8 +75,6 @@ public:
 private:
     // Takes pose k (its depth checked, its table candidates kept); false when it is unusable.
     bool Accept(std::size_t k, PreparedPose pose);
-    // Add and AddAll: the new poses with their commanded angles.
-    void AddPoses(std::vector<PreparedPose> poses);
     void TryTable();  // the provisional table frame from the candidates so far
     void SegmentInto(std::size_t k, const DepthMap& depth);
     bool Blocked() const { return unusable_.has_value(); }

@@ -156,7 +156,7 @@ Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms
         };
         callbacks.on_pose = [preparer, unit, this](std::size_t index, const SessionPose& pose) {
             last_frame_at_ = std::chrono::steady_clock::now();
-            (*preparer)->Add(index, pose.angle_deg, pose.frames, unit);
+            (*preparer)->Add(index, pose.frames, unit);
         };
         callbacks.stop = [preparer](int captured) { return (*preparer)->ShouldStop(captured); };
     }

@@ -44,11 +44,10 @@ PosePreparer::~PosePreparer() {
     if (worker_.joinable()) worker_.join();
 }
 
-void PosePreparer::Add(std::size_t index, double angle_deg, std::vector<DepthImage> frames,
-                       double depth_unit_m) {
+void PosePreparer::Add(std::size_t index, std::vector<DepthImage> frames, double depth_unit_m) {
     {
         std::lock_guard lock(mutex_);
-        queue_.push_back(Job{index, angle_deg, std::move(frames), depth_unit_m});
+        queue_.push_back(Job{index, std::move(frames), depth_unit_m});
     }
     wake_.notify_all();
 }
@@ -61,15 +60,12 @@ void PosePreparer::Work() {
         Job job = std::move(queue_.front());
         queue_.pop_front();
         lock.unlock();
-        waiting_.emplace(job.index, std::pair(job.angle_deg, PreparePose(job.frames,
-                                                                         job.depth_unit_m,
-                                                                         config_)));
+        waiting_.emplace(job.index, PreparePose(job.frames, job.depth_unit_m, config_));
         // The stream takes the poses in order; a pose ahead of its turn waits for the others.
         for (auto it = waiting_.find(static_cast<std::size_t>(stream_.Added()));
              it != waiting_.end();
              it = waiting_.find(static_cast<std::size_t>(stream_.Added()))) {
-            streamed_deg_.push_back(it->second.first);
-            stream_.Add(std::move(it->second.second));
+            stream_.Add(std::move(it->second));
             waiting_.erase(it);
             streamed_.store(stream_.Added());
         }
@@ -98,12 +94,13 @@ void PosePreparer::TryDetermine() {
         std::lock_guard lock(mutex_);
         if (!queue_.empty() || stop_) return;  // a newer pose is here: measure with it
     }
-    if (WidestGapDeg(streamed_deg_) > kSurroundGapDeg) return done(false, INFINITY, std::nullopt);
+    const std::vector<double> angles(plan_deg_.begin(), plan_deg_.begin() + added);
+    if (WidestGapDeg(angles) > kSurroundGapDeg) return done(false, INFINITY, std::nullopt);
     std::unique_ptr<ViewStream> so_far = stream_.SoFar();
     if (!so_far) return done(false, INFINITY, std::nullopt);
     Session session = header_;
     session.poses.clear();
-    for (double a : streamed_deg_) session.poses.push_back(SessionPose{a, {}, {}});
+    for (double a : angles) session.poses.push_back(SessionPose{a, {}, {}});
     auto out = MeasureStreamed(session, *so_far, config_, method_, SteadyClockMs());
     if (!out) return done(true, INFINITY, std::nullopt);
     const MeasurementResult& r = out->result;
@@ -189,7 +186,7 @@ ViewStream& PosePreparer::Finish(const Session& session) {
     ParallelFor(static_cast<int>(rest.size()), config_.threads, [&](int k) {
         const std::size_t i = first + static_cast<std::size_t>(k);
         if (auto it = waiting_.find(i); it != waiting_.end()) {
-            rest[static_cast<std::size_t>(k)] = std::move(it->second.second);
+            rest[static_cast<std::size_t>(k)] = std::move(it->second);
         } else if (const Job* job = queued[static_cast<std::size_t>(k)]) {
             rest[static_cast<std::size_t>(k)] = PreparePose(job->frames, job->depth_unit_m, config_);
         } else {

@@ -54,10 +54,9 @@ public:
     PosePreparer(const PosePreparer&) = delete;
     PosePreparer& operator=(const PosePreparer&) = delete;
 
-    // Queues pose `index` (commanded `angle_deg` from pose 0) with its raw frames (of a camera
-    // with `depth_unit_m`); returns at once.
-    void Add(std::size_t index, double angle_deg, std::vector<DepthImage> frames,
-             double depth_unit_m);
+    // Queues pose `index` of the plan with its raw frames (of a camera with `depth_unit_m`);
+    // returns at once.
+    void Add(std::size_t index, std::vector<DepthImage> frames, double depth_unit_m);
 
     // Whether the poses measured so far determine the box within the target.
     bool Determined() const { return determined_.load(); }
@@ -94,7 +93,6 @@ private:
 
     struct Job {
         std::size_t index;
-        double angle_deg;
         std::vector<DepthImage> frames;
         double depth_unit_m;
     };
@@ -107,10 +105,9 @@ private:
     mutable std::mutex mutex_;
     std::condition_variable wake_;
     std::deque<Job> queue_;
-    // Prepared poses waiting for the ones before them, by index, with their angles.
-    std::map<std::size_t, std::pair<double, PreparedPose>> waiting_;
+    // Prepared poses waiting for the ones before them, by index.
+    std::map<std::size_t, PreparedPose> waiting_;
     ViewStream stream_;  // the worker's alone until Finish joins it
-    std::vector<double> streamed_deg_;  // the worker's: the angles of the poses streamed
     std::atomic<int> streamed_{0};
     std::atomic<bool> determined_{false};
     // Guarded by mutex_: how many poses the last measurement so far had (or was passed over

@@ -73,8 +73,8 @@ Result<DepthImage> SimulatedCamera::Grab(std::chrono::milliseconds timeout) {
         // The next frame the sensor exposes: at the next tick of its period, one frame per tick.
         const auto period = std::chrono::milliseconds(config_.frame_interval_ms);
         const auto since = std::chrono::steady_clock::now() - streaming_since_;
-        const long long tick = std::max(last_frame_tick_ + 1,
-                                        static_cast<long long>((since + period - std::chrono::nanoseconds(1)) / period));
+        const auto next = (since + period - std::chrono::nanoseconds(1)) / period;
+        const long long tick = std::max(last_frame_tick_ + 1, static_cast<long long>(next));
         std::this_thread::sleep_until(streaming_since_ + tick * period);
         last_frame_tick_ = tick;
     }

@@ -24,11 +24,9 @@ Session SixPoses(unsigned seed) {
     return session.ok() ? *session : Session{};
 }
 
-// Hands pose `i` of `session` to `preparer`, at its angle plus `angle_error_deg`.
-void Hand(PosePreparer& preparer, const Session& session, std::size_t i,
-          double angle_error_deg = 0.0) {
-    preparer.Add(i, session.poses[i].angle_deg + angle_error_deg, session.poses[i].frames,
-                 session.camera.depth_unit_m);
+// Hands pose `i` of `session` to `preparer`.
+void Hand(PosePreparer& preparer, const Session& session, std::size_t i) {
+    preparer.Add(i, session.poses[i].frames, session.camera.depth_unit_m);
 }
 
 // Returns the session's measurement through a stream fed all at once.
@@ -68,7 +66,7 @@ TEST(PosePreparer, StartsOverWhenTheCaptureIsNotThePlan) {
     plan[1] += 7.0;
     PosePreparer preparer(config, session, plan);
     Hand(preparer, session, 0);
-    Hand(preparer, session, 1, 7.0);
+    Hand(preparer, session, 1);
     ViewStream& stream = preparer.Finish(session);
     EXPECT_TRUE(stream.Matches(session));
     auto streamed = MeasureStreamed(session, stream, config, BoxMethod::kFootprint);
@@ -84,7 +82,7 @@ TEST(PosePreparer, StopsCleanlyWithWorkQueued) {
     auto preparer = std::make_unique<PosePreparer>(MeasureConfig{}, *session,
                                                    session->PoseAnglesDeg());
     for (int k = 0; k < 20; ++k) {
-        preparer->Add(static_cast<std::size_t>(k % 2), 0.0, session->poses[0].frames,
+        preparer->Add(static_cast<std::size_t>(k % 2), session->poses[0].frames,
                       session->camera.depth_unit_m);
     }
     preparer.reset();  // an aborted measurement: must neither hang nor crash
