@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 
 namespace boxd {
 
@@ -14,8 +15,93 @@ Status Bad(const std::string& field, const std::string& why) {
 
 bool NonNegative(double v) { return std::isfinite(v) && v >= 0.0; }
 
-// Sessions hold at most a few dozen frames per pose; larger counts use the heap path.
-constexpr std::size_t kStackReadings = 64;
+// What averaging needs for every pixel of a pose.
+struct AveragingPass {
+    std::vector<const std::uint16_t*> src;  // the frames' pixel arrays
+    std::size_t required = 1;               // valid readings a pixel needs
+    std::vector<std::uint32_t> window;      // agreement window (raw units) by median reading
+    double unit = 0.001;
+};
+
+// Averages the pass's N frames into *out, pixel by pixel (a refused pixel stays 0). The rule:
+// the lower median of the valid readings, then the mean of those within the median's agreement
+// window, when they are enough and a strict majority.
+// N fixed at compile time, and nothing branches on the readings (they are noise: any branch on
+// them would be mispredicted about half the time), so the median loop vectorises. A reading
+// of 0 (no return) ranks above every valid one: the lower median of the k valid readings is
+// the one with (k - 1) / 2 readings before it (ties broken by frame order).
+template <std::size_t N>
+void AverageAll(const AveragingPass& pass, DepthMap* out) {
+    constexpr std::size_t kBlock = 1024;
+    constexpr std::uint32_t kNone = 0x10000u;  // above every 16-bit reading
+    std::array<std::uint32_t, kBlock> median{}, valid{};
+    const std::size_t count = out->z_m.size();
+    for (std::size_t start = 0; start < count; start += kBlock) {
+        const std::size_t len = std::min(kBlock, count - start);
+        for (std::size_t p = 0; p < len; ++p) {
+            std::array<std::uint32_t, N> r{};
+            std::uint32_t k = 0;
+            for (std::size_t f = 0; f < N; ++f) {
+                const std::uint32_t v = pass.src[f][start + p];
+                k += v != 0 ? 1u : 0u;
+                r[f] = v != 0 ? v : kNone;
+            }
+            const std::uint32_t m = (k > 0 ? k - 1 : 0) / 2;
+            std::uint32_t med = 0;
+            for (std::size_t a = 0; a < N; ++a) {
+                std::uint32_t rank = 0;
+                for (std::size_t b = 0; b < N; ++b) {
+                    rank += (r[b] < r[a] || (r[b] == r[a] && b < a)) ? 1u : 0u;
+                }
+                med += rank == m ? r[a] : 0u;
+            }
+            median[p] = med;
+            valid[p] = k;
+        }
+        for (std::size_t p = 0; p < len; ++p) {
+            if (valid[p] < pass.required) continue;
+            const std::uint32_t med = median[p];
+            const std::uint32_t tol = pass.window[med];
+            std::uint32_t sum = 0, kept = 0;
+            for (std::size_t f = 0; f < N; ++f) {
+                const std::uint32_t v = pass.src[f][start + p];
+                const std::uint32_t d = v > med ? v - med : med - v;
+                const bool agrees = v != 0 && d <= tol;
+                sum += agrees ? v : 0u;
+                kept += agrees ? 1u : 0u;
+            }
+            // No strict majority agrees: the pixel is unstable (an edge or a moving surface).
+            if (kept < pass.required || 2 * kept <= valid[p]) continue;
+            out->z_m[start + p] =
+                static_cast<float>(static_cast<double>(sum) * pass.unit / static_cast<double>(kept));
+        }
+    }
+}
+
+// Any number of frames: the same rule through a sort of the valid readings.
+void AveragePixelAnyCount(const AveragingPass& pass, std::size_t i, std::uint16_t* r,
+                          float* out) {
+    std::size_t k = 0;
+    for (const std::uint16_t* frame : pass.src) {
+        if (frame[i] != 0) r[k++] = frame[i];
+    }
+    if (k < pass.required) return;
+    const std::size_t m = (k - 1) / 2;
+    std::nth_element(r, r + m, r + k);
+    const std::uint32_t median = r[m];
+    const std::uint32_t tol = pass.window[median];
+    std::uint64_t sum = 0;
+    std::size_t kept = 0;
+    for (std::size_t j = 0; j < k; ++j) {
+        const std::uint32_t v = r[j];
+        if ((v > median ? v - median : median - v) <= tol) {
+            sum += v;
+            ++kept;
+        }
+    }
+    if (kept < pass.required || 2 * kept <= k) return;
+    *out = static_cast<float>(static_cast<double>(sum) * pass.unit / static_cast<double>(kept));
+}
 
 }  // namespace
 
@@ -49,79 +135,101 @@ Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, doubl
         }
     }
     const std::size_t n = frames.size();
-    const std::size_t required = std::max<std::size_t>(
+    AveragingPass pass;
+    pass.required = std::max<std::size_t>(
         1, static_cast<std::size_t>(std::ceil(config.min_valid_fraction * n - 1e-9)));
+    pass.unit = depth_unit_m;
+    for (const DepthImage& f : frames) pass.src.push_back(f.pixels.data());
+    // The agreement window of SPEC section 7's sensor model grows with depth: looked up per raw
+    // median reading (in raw units) instead of computed in metres for every pixel.
+    pass.window.resize(65536);
+    for (std::size_t v = 0; v < pass.window.size(); ++v) {
+        const double z = static_cast<double>(v) * depth_unit_m;
+        const double tol = config.agreement_abs_m + config.agreement_rel_per_m * z * z;
+        // Truncation is the floor here (the window is never negative), and it vectorises.
+        pass.window[v] = static_cast<std::uint32_t>(std::min(65535.0, tol / depth_unit_m));
+    }
     DepthMap out(w, h);
-    std::vector<std::uint16_t> heap(n > kStackReadings ? n : 0);
-    std::array<std::uint16_t, kStackReadings> stack{};
-    std::uint16_t* r = n > kStackReadings ? heap.data() : stack.data();
-    // The frames' pixel arrays, looked up once instead of through the vectors for every pixel.
-    std::vector<const std::uint16_t*> src(n);
-    for (std::size_t f = 0; f < n; ++f) src[f] = frames[f].pixels.data();
-    const std::size_t count = out.z_m.size();
-    for (std::size_t i = 0; i < count; ++i) {
-        std::size_t k = 0;
-        for (std::size_t f = 0; f < n; ++f) {
-            const std::uint16_t v = src[f][i];
-            if (v != 0) r[k++] = v;
-        }
-        if (k < required) continue;
-        // Median of the valid readings (lower median for even counts: deterministic, and the
-        // agreement window below is symmetric enough for it).
-        if (k <= 16) {
-            // Insertion sort: a handful of readings per pixel, far cheaper than nth_element.
-            for (std::size_t a = 1; a < k; ++a) {
-                const std::uint16_t v = r[a];
-                std::size_t b = a;
-                for (; b > 0 && r[b - 1] > v; --b) r[b] = r[b - 1];
-                r[b] = v;
-            }
-        } else {
-            std::nth_element(r, r + (k - 1) / 2, r + k);
-        }
-        const double median = r[(k - 1) / 2] * depth_unit_m;
-        const double tol = config.agreement_abs_m + config.agreement_rel_per_m * median * median;
-        double sum = 0.0;
-        std::size_t kept = 0;
-        for (std::size_t j = 0; j < k; ++j) {
-            const double z = r[j] * depth_unit_m;
-            if (std::abs(z - median) <= tol) {
-                sum += z;
-                ++kept;
+    switch (n) {
+        case 1: AverageAll<1>(pass, &out); break;
+        case 2: AverageAll<2>(pass, &out); break;
+        case 3: AverageAll<3>(pass, &out); break;
+        case 4: AverageAll<4>(pass, &out); break;
+        case 5: AverageAll<5>(pass, &out); break;
+        case 6: AverageAll<6>(pass, &out); break;
+        case 7: AverageAll<7>(pass, &out); break;
+        case 8: AverageAll<8>(pass, &out); break;
+        default: {
+            std::vector<std::uint16_t> r(n);
+            for (std::size_t i = 0; i < out.z_m.size(); ++i) {
+                AveragePixelAnyCount(pass, i, r.data(), &out.z_m[i]);
             }
         }
-        // No strict majority agrees: the pixel is unstable (an edge or a moving surface).
-        if (kept < required || 2 * kept <= k) continue;
-        out.z_m[i] = static_cast<float>(sum / static_cast<double>(kept));
     }
     return out;
 }
 
+namespace {
+
+// Whether the reading z at column x of `row` jumps from a valid neighbour among the columns
+// x0..x1 of the rows `rows` by more than tol (the pixel itself never differs from itself).
+bool Jumps(const std::array<const float*, 3>& rows, int nrows, int x0, int x1, float z,
+           float tol) {
+    bool jumps = false;
+    for (int r = 0; r < nrows; ++r) {
+        for (int xx = x0; xx <= x1; ++xx) {
+            const float zn = rows[static_cast<std::size_t>(r)][xx];
+            jumps |= zn > 0.0f && std::abs(zn - z) > tol;
+        }
+    }
+    return jumps;
+}
+
+}  // namespace
+
 DepthMap RemoveFlyingPixels(const DepthMap& depth, const FlyingPixelConfig& config) {
     DepthMap cur = depth;
     const int w = depth.width, h = depth.height;
+    const auto abs_m = static_cast<float>(config.jump_abs_m);
+    const auto rel = static_cast<float>(config.jump_rel);
     for (int pass = 0; pass < config.passes; ++pass) {
         DepthMap next = cur;
         for (int y = 0; y < h; ++y) {
-            for (int x = 0; x < w; ++x) {
-                const float z = cur.at(x, y);
-                if (z <= 0.0f) continue;
-                const float tol = static_cast<float>(config.jump_abs_m + config.jump_rel * z);
-                bool flying = false;
-                for (int dy = -1; dy <= 1 && !flying; ++dy) {
-                    const int yy = y + dy;
-                    if (yy < 0 || yy >= h) continue;
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        const int xx = x + dx;
-                        if (xx < 0 || xx >= w || (dx == 0 && dy == 0)) continue;
-                        const float zn = cur.at(xx, yy);
-                        if (zn > 0.0f && std::abs(zn - z) > tol) {
-                            flying = true;
-                            break;
-                        }
-                    }
+            // The rows around y (those outside the image are left out).
+            std::array<const float*, 3> rows{};
+            int nrows = 0;
+            for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy) {
+                rows[static_cast<std::size_t>(nrows++)] =
+                    cur.z_m.data() + static_cast<std::size_t>(yy) * static_cast<std::size_t>(w);
+            }
+            const float* row = cur.z_m.data() + static_cast<std::size_t>(y) * w;
+            float* out = next.z_m.data() + static_cast<std::size_t>(y) * w;
+            // Inside the image, nothing branches on the readings (the loop vectorises); the
+            // first and last columns take the bounded path.
+            if (nrows == 3 && w > 2) {
+                const float* up = rows[0];
+                const float* down = rows[2];
+                for (int x = 1; x < w - 1; ++x) {
+                    const float z = row[x];
+                    const float tol = abs_m + rel * z;
+                    // Bitwise, not short-circuit: no branch in the loop.
+                    auto jump = [z, tol](float zn) {
+                        return static_cast<int>(zn > 0.0f) & static_cast<int>(std::abs(zn - z) > tol);
+                    };
+                    const int jumps = jump(up[x - 1]) | jump(up[x]) | jump(up[x + 1]) |
+                                      jump(row[x - 1]) | jump(row[x + 1]) | jump(down[x - 1]) |
+                                      jump(down[x]) | jump(down[x + 1]);
+                    out[x] = (static_cast<int>(z > 0.0f) & jumps) != 0 ? 0.0f : z;
                 }
-                if (flying) next.at(x, y) = 0.0f;
+            }
+            for (int x = 0; x < w; ++x) {
+                if (nrows == 3 && x > 0 && x < w - 1) x = w - 1;
+                const float z = row[x];
+                if (z <= 0.0f) continue;
+                if (Jumps(rows, nrows, std::max(0, x - 1), std::min(w - 1, x + 1), z,
+                          abs_m + rel * z)) {
+                    out[x] = 0.0f;
+                }
             }
         }
         cur = std::move(next);

@@ -1,10 +1,10 @@
 #include "pipeline/registration_cloud.h"
 
-#include <pcl/features/normal_3d.h>
-#include <pcl/filters/statistical_outlier_removal.h>
+#include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/point_cloud.h>
 #include <pcl/point_types.h>
-#include <pcl/search/kdtree.h>
+
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
@@ -91,43 +91,106 @@ Points ReduceVoxels(const WeightedVoxels& base, double base_voxel_m,
     return std::move(v.centroids);
 }
 
+// The k nearest neighbours of every point of a cloud (each point first, at distance 0), from
+// PCL's kd-tree (FLANN). Only this tree is taken from PCL: its filter and feature classes would
+// each build their own tree, and their libraries cost the process ~90,000 symbol relocations
+// at every start, more than everything else boxd links together.
+class Neighbours {
+public:
+    explicit Neighbours(const Points& points) : cloud_(new pcl::PointCloud<pcl::PointXYZ>) {
+        cloud_->reserve(points.size());
+        for (const auto& p : points) cloud_->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
+        tree_.setSortedResults(true);
+        tree_.setInputCloud(cloud_);
+    }
+
+    // Fills `index` and `sqr_dist` with the k nearest neighbours of point i; returns how many.
+    int Of(std::size_t i, int k) {
+        return tree_.nearestKSearch(static_cast<pcl::index_t>(i), k, index_, sqr_dist_);
+    }
+    const pcl::Indices& index() const { return index_; }
+    const std::vector<float>& sqr_dist() const { return sqr_dist_; }
+
+private:
+    pcl::PointCloud<pcl::PointXYZ>::Ptr cloud_;
+    pcl::KdTreeFLANN<pcl::PointXYZ> tree_;
+    pcl::Indices index_;
+    std::vector<float> sqr_dist_;
+};
+
+// Statistical outlier removal (Rusu et al. 2008): a point whose mean distance to its k nearest
+// neighbours exceeds the mean of those distances by more than `std_ratio` standard deviations
+// (over the whole cloud) is an outlier. Returns the kept points in their order.
+Points RemoveStatisticalOutliers(const Points& points, int k, double std_ratio) {
+    Neighbours near(points);
+    std::vector<double> mean_dist(points.size(), 0.0);
+    double sum = 0.0, sum_sq = 0.0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const int found = near.Of(i, k + 1);
+        double d = 0.0;
+        for (int j = 1; j < found; ++j) d += std::sqrt(near.sqr_dist()[static_cast<std::size_t>(j)]);
+        mean_dist[i] = found > 1 ? d / (found - 1) : 0.0;
+        sum += mean_dist[i];
+        sum_sq += mean_dist[i] * mean_dist[i];
+    }
+    const double n = static_cast<double>(points.size());
+    const double mean = sum / n;
+    const double variance = n > 1.0 ? std::max(0.0, (sum_sq - sum * sum / n) / (n - 1.0)) : 0.0;
+    const double threshold = mean + std_ratio * std::sqrt(variance);
+    Points kept;
+    kept.reserve(points.size());
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        if (mean_dist[i] <= threshold) kept.push_back(points[i]);
+    }
+    return kept;
+}
+
+// The normal of a point's neighbourhood (the least-variance axis of its scatter, in double
+// about its mean) and its surface variation λ0 / (λ0 + λ1 + λ2) (Pauly et al. 2002).
+struct LocalPlane {
+    Eigen::Vector3f normal;
+    double variation = 0.0;
+};
+
+LocalPlane FitLocalPlane(const Points& points, const pcl::Indices& index, int count) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int j = 0; j < count; ++j) mean += points[static_cast<std::size_t>(index[j])].cast<double>();
+    mean /= count;
+    Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+    for (int j = 0; j < count; ++j) {
+        const Eigen::Vector3d d = points[static_cast<std::size_t>(index[j])].cast<double>() - mean;
+        scatter += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+    eig.computeDirect(scatter / count);
+    const Eigen::Vector3d lambda = eig.eigenvalues().cwiseMax(0.0);  // ascending
+    const double total = lambda.sum();
+    return {eig.eigenvectors().col(0).cast<float>().normalized(),
+            total > 0.0 ? lambda[0] / total : 0.0};
+}
+
 // Statistical outlier removal and normals of the voxel centroids, facing `viewpoint`.
 OrientedPoints Orient(const Points& voxels, const RegistrationCloudConfig& config,
                       const Eigen::Vector3f& viewpoint) {
     OrientedPoints out;
-    if (voxels.size() < static_cast<std::size_t>(config.normal_neighbors) + 1) return out;
-    pcl::PointCloud<pcl::PointXYZ>::Ptr cloud(new pcl::PointCloud<pcl::PointXYZ>);
-    cloud->reserve(voxels.size());
-    for (const auto& p : voxels) cloud->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-    if (config.outlier_neighbors > 0) {
-        pcl::PointCloud<pcl::PointXYZ>::Ptr kept(new pcl::PointCloud<pcl::PointXYZ>);
-        pcl::StatisticalOutlierRemoval<pcl::PointXYZ> sor;
-        sor.setInputCloud(cloud);
-        sor.setMeanK(config.outlier_neighbors);
-        sor.setStddevMulThresh(config.outlier_std_ratio);
-        sor.filter(*kept);
-        cloud = kept;
-    }
-    if (cloud->size() < static_cast<std::size_t>(config.normal_neighbors) + 1) return out;
-    pcl::PointCloud<pcl::Normal> normals;
-    pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
-    ne.setInputCloud(cloud);
-    ne.setSearchMethod(
-        pcl::search::KdTree<pcl::PointXYZ>::Ptr(new pcl::search::KdTree<pcl::PointXYZ>));
-    ne.setKSearch(config.normal_neighbors);
-    ne.compute(normals);
-    for (std::size_t i = 0; i < cloud->size(); ++i) {
-        const pcl::Normal& n = normals[i];
-        if (!std::isfinite(n.normal_x) || !std::isfinite(n.normal_y) ||
-            !std::isfinite(n.normal_z)) {
-            continue;
-        }
-        if (n.curvature > config.max_surface_variation) continue;
-        const pcl::PointXYZ& p = (*cloud)[i];
-        const Eigen::Vector3f point(p.x, p.y, p.z);
-        Eigen::Vector3f normal = Eigen::Vector3f(n.normal_x, n.normal_y, n.normal_z).normalized();
-        if (normal.dot(viewpoint - point) < 0.0f) normal = -normal;
-        out.points.push_back(point);
+    const auto normal_k = static_cast<std::size_t>(config.normal_neighbors);
+    if (voxels.size() < normal_k + 1) return out;
+    const Points cloud =
+        config.outlier_neighbors > 0
+            ? RemoveStatisticalOutliers(voxels, config.outlier_neighbors, config.outlier_std_ratio)
+            : voxels;
+    if (cloud.size() < normal_k + 1) return out;
+    Neighbours near(cloud);
+    out.points.reserve(cloud.size());
+    out.normals.reserve(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+        const int found = near.Of(i, config.normal_neighbors);
+        if (found < 3) continue;
+        const LocalPlane plane = FitLocalPlane(cloud, near.index(), found);
+        if (!plane.normal.allFinite() || plane.variation > config.max_surface_variation) continue;
+        Eigen::Vector3f normal = plane.normal;
+        if (normal.dot(viewpoint - cloud[i]) < 0.0f) normal = -normal;
+        out.points.push_back(cloud[i]);
         out.normals.push_back(normal);
     }
     return out;

@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <random>
+
 namespace boxd {
 namespace {
 
@@ -46,6 +50,59 @@ TEST(AverageDepthFrames, RejectsMismatchedSizesAndNoFrames) {
     frames.push_back(DepthImage(4, 3));
     EXPECT_FALSE(AverageDepthFrames(frames, 0.001, AveragingConfig{}).ok());
     EXPECT_FALSE(AverageDepthFrames({}, 0.001, AveragingConfig{}).ok());
+}
+
+// The averaging rule written plainly (sort, lower median, window in metres): the reference the
+// branch-free implementation must reproduce.
+float ReferenceAverage(std::vector<std::uint16_t> readings, double unit, std::size_t required,
+                       const AveragingConfig& c) {
+    std::vector<std::uint16_t> valid;
+    for (std::uint16_t v : readings) {
+        if (v != 0) valid.push_back(v);
+    }
+    if (valid.size() < required) return 0.0f;
+    std::sort(valid.begin(), valid.end());
+    const double median = valid[(valid.size() - 1) / 2] * unit;
+    const double tol = c.agreement_abs_m + c.agreement_rel_per_m * median * median;
+    double sum = 0.0;
+    std::size_t kept = 0;
+    for (std::uint16_t v : valid) {
+        if (std::abs(v * unit - median) <= tol + 1e-12) {
+            sum += v * unit;
+            ++kept;
+        }
+    }
+    if (kept < required || 2 * kept <= valid.size()) return 0.0f;
+    return static_cast<float>(sum / static_cast<double>(kept));
+}
+
+TEST(AverageDepthFrames, MatchesThePlainRuleOnRandomReadingsForEveryFrameCount) {
+    std::mt19937 rng(7);
+    const AveragingConfig config;
+    for (std::size_t n : {1, 2, 3, 4, 5, 7, 8, 9, 12, 20}) {
+        std::vector<DepthImage> frames(n, DepthImage(64, 16));
+        std::uniform_int_distribution<int> base(300, 9000), noise(-12, 12), kind(0, 9);
+        for (std::size_t i = 0; i < frames[0].pixels.size(); ++i) {
+            const int b = base(rng);
+            for (auto& f : frames) {
+                const int k = kind(rng);  // mostly near the base; some dropouts, some far off
+                const int v = k == 0 ? 0 : k == 1 ? b + 700 : b + noise(rng);
+                f.pixels[i] = static_cast<std::uint16_t>(v);
+            }
+        }
+        const std::size_t required = static_cast<std::size_t>(
+            std::ceil(config.min_valid_fraction * static_cast<double>(n) - 1e-9));
+        auto avg = AverageDepthFrames(frames, 0.001, config);
+        ASSERT_TRUE(avg.ok());
+        for (std::size_t i = 0; i < frames[0].pixels.size(); ++i) {
+            std::vector<std::uint16_t> readings;
+            for (const auto& f : frames) readings.push_back(f.pixels[i]);
+            ASSERT_FLOAT_EQ(avg->z_m[i],
+                            ReferenceAverage(readings, 0.001, std::max<std::size_t>(1, required),
+                                             config))
+                << n << " frames, pixel " << i;
+        }
+    }
 }
 
 TEST(RemoveFlyingPixels, RemovesMixedPixelBetweenSurfaces) {
