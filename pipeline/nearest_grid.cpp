@@ -60,31 +60,34 @@ NearestGrid::NearestGrid(const Points& points, float cell_m, std::size_t max_cel
     }
 }
 
+bool NearestGrid::CellRange(const Eigen::Vector3f& p, float radius,
+                            std::array<int, 6>* range) const {
+    const Eigen::Vector3f a = (p - origin_) * inv_cell_;
+    const float r = radius * inv_cell_;
+    const std::array<int, 3> n{nx_, ny_, nz_};
+    for (int axis = 0; axis < 3; ++axis) {
+        const float l = std::floor(a[axis] - r), h = std::floor(a[axis] + r);
+        const int last = n[static_cast<std::size_t>(axis)] - 1;
+        if (h < 0.0f || l > static_cast<float>(last)) return false;
+        // Clamped in float first: a huge radius must not overflow the conversion.
+        (*range)[static_cast<std::size_t>(2 * axis)] = l <= 0.0f ? 0 : static_cast<int>(l);
+        (*range)[static_cast<std::size_t>(2 * axis + 1)] =
+            h >= static_cast<float>(last) ? last : static_cast<int>(h);
+    }
+    return true;
+}
+
 int NearestGrid::Nearest(const Eigen::Vector3f& p, float max_dist) const {
     if (sorted_.empty() || !p.allFinite() || !(max_dist >= 0.0f)) return -1;
-    // The cells that overlap the query's bounding cube, clipped to the grid.
-    const Eigen::Vector3f a = (p - origin_) * inv_cell_;
-    const float r = max_dist * inv_cell_;
-    auto range = [](float v, float rad, int n, int& lo, int& hi) {
-        const float l = std::floor(v - rad), h = std::floor(v + rad);
-        if (h < 0.0f || l > static_cast<float>(n - 1)) return false;
-        // Clamped in float first: a huge radius must not overflow the conversion.
-        lo = l <= 0.0f ? 0 : static_cast<int>(l);
-        hi = h >= static_cast<float>(n - 1) ? n - 1 : static_cast<int>(h);
-        return true;
-    };
-    int x0, x1, y0, y1, z0, z1;
-    if (!range(a.x(), r, nx_, x0, x1) || !range(a.y(), r, ny_, y0, y1) ||
-        !range(a.z(), r, nz_, z0, z1)) {
-        return -1;
-    }
+    std::array<int, 6> c{};
+    if (!CellRange(p, max_dist, &c)) return -1;
     float best = max_dist * max_dist;
     int best_index = -1;
-    for (int z = z0; z <= z1; ++z) {
-        for (int y = y0; y <= y1; ++y) {
+    for (int z = c[4]; z <= c[5]; ++z) {
+        for (int y = c[2]; y <= c[3]; ++y) {
             const std::size_t row = (static_cast<std::size_t>(z) * ny_ + y) * nx_;
-            const std::uint32_t end = start_[row + static_cast<std::size_t>(x1) + 1];
-            for (std::uint32_t s = start_[row + static_cast<std::size_t>(x0)]; s < end; ++s) {
+            const std::uint32_t end = start_[row + static_cast<std::size_t>(c[1]) + 1];
+            for (std::uint32_t s = start_[row + static_cast<std::size_t>(c[0])]; s < end; ++s) {
                 const float d2 = (sorted_[s] - p).squaredNorm();
                 const int idx = static_cast<int>(index_[s]);
                 if (d2 < best || (d2 == best && (best_index < 0 || idx < best_index))) {
@@ -95,6 +98,48 @@ int NearestGrid::Nearest(const Eigen::Vector3f& p, float max_dist) const {
         }
     }
     return best_index;
+}
+
+void NearestGrid::Within(const Eigen::Vector3f& p, float radius,
+                         std::vector<Neighbour>* out) const {
+    std::array<int, 6> c{};
+    if (!CellRange(p, radius, &c)) return;
+    const float r2 = radius * radius;
+    for (int z = c[4]; z <= c[5]; ++z) {
+        for (int y = c[2]; y <= c[3]; ++y) {
+            const std::size_t row = (static_cast<std::size_t>(z) * ny_ + y) * nx_;
+            const std::uint32_t end = start_[row + static_cast<std::size_t>(c[1]) + 1];
+            for (std::uint32_t s = start_[row + static_cast<std::size_t>(c[0])]; s < end; ++s) {
+                const float d2 = (sorted_[s] - p).squaredNorm();
+                if (d2 <= r2) out->push_back({d2, static_cast<int>(index_[s])});
+            }
+        }
+    }
+}
+
+void NearestGrid::KNearest(const Eigen::Vector3f& p, int k, std::vector<Neighbour>* out) const {
+    out->clear();
+    if (sorted_.empty() || k <= 0 || !p.allFinite()) return;
+    const auto want = static_cast<std::size_t>(k);
+    // Every point lies within the grid's diagonal of any point inside it; beyond that (or for
+    // a query far outside) one more doubling covers them all.
+    const float reach =
+        cell_ * std::sqrt(static_cast<float>(nx_ * nx_ + ny_ * ny_ + nz_ * nz_)) +
+        (p - origin_).norm();
+    for (float radius = cell_;; radius *= 2.0f) {
+        out->clear();
+        Within(p, radius, out);
+        if (out->size() >= want || radius > reach) break;
+    }
+    auto closer = [](const Neighbour& a, const Neighbour& b) {
+        return a.sqr_dist < b.sqr_dist || (a.sqr_dist == b.sqr_dist && a.index < b.index);
+    };
+    if (out->size() > want) {
+        std::partial_sort(out->begin(), out->begin() + static_cast<long>(want), out->end(), closer);
+        out->resize(want);
+    } else {
+        std::sort(out->begin(), out->end(), closer);
+    }
 }
 
 }  // namespace boxd

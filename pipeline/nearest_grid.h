@@ -3,6 +3,7 @@
 // every source point asks for its nearest target point within the correspondence gate.
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -24,9 +25,27 @@ public:
     // answer never depends on the layout.
     int Nearest(const Eigen::Vector3f& p, float max_dist) const;
 
+    // One of KNearest's neighbours: its index into the constructor's points and its squared
+    // distance to the query.
+    struct Neighbour {
+        float sqr_dist;
+        int index;
+    };
+
+    // Fills `out` with the k points nearest to `p`, nearest first (ties: lower index first),
+    // or with every point when there are fewer. Exact: the search grows from one cell until
+    // the k-th nearest found lies within the radius it has covered.
+    void KNearest(const Eigen::Vector3f& p, int k, std::vector<Neighbour>* out) const;
+
     float cell_m() const { return cell_; }
 
 private:
+    // Appends to `out` every point within `radius` of `p` (unordered).
+    void Within(const Eigen::Vector3f& p, float radius, std::vector<Neighbour>* out) const;
+    // The cells overlapping the cube of half-edge `radius` about `p`, clipped to the grid;
+    // false when the cube misses the grid.
+    bool CellRange(const Eigen::Vector3f& p, float radius, std::array<int, 6>* range) const;
+
     Eigen::Vector3f origin_ = Eigen::Vector3f::Zero();
     float cell_ = 0.0f;
     float inv_cell_ = 0.0f;

@@ -1,14 +1,12 @@
 #include "pipeline/registration_cloud.h"
 
-#include <pcl/kdtree/kdtree_flann.h>
-#include <pcl/point_cloud.h>
-#include <pcl/point_types.h>
-
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+
+#include "pipeline/nearest_grid.h"
 
 namespace boxd {
 
@@ -51,18 +49,26 @@ WeightedVoxels VoxelGrid(const Points& points, const std::vector<float>* weights
     std::vector<std::int32_t> slot_of(capacity, -1);
     std::vector<Eigen::Vector3d> sums;
     std::vector<double> totals;
+    // A view's points come in image order, so neighbours in the list mostly share a voxel:
+    // the previous point's voxel is checked before the table.
+    std::uint64_t last_key = 0;
+    std::size_t last_v = 0;
     for (std::size_t i = 0; i < points.size(); ++i) {
         const std::uint64_t key = VoxelKey(points[i], inv);
-        // Fibonacci hashing (Knuth, TAOCP 6.4), linear probing.
-        std::size_t h = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> shift);
-        while (slot_of[h] >= 0 && keys[h] != key) h = (h + 1) & (capacity - 1);
-        if (slot_of[h] < 0) {
-            keys[h] = key;
-            slot_of[h] = static_cast<std::int32_t>(sums.size());
-            sums.emplace_back(Eigen::Vector3d::Zero());
-            totals.push_back(0.0);
+        if (i == 0 || key != last_key) {
+            // Fibonacci hashing (Knuth, TAOCP 6.4), linear probing.
+            std::size_t h = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> shift);
+            while (slot_of[h] >= 0 && keys[h] != key) h = (h + 1) & (capacity - 1);
+            if (slot_of[h] < 0) {
+                keys[h] = key;
+                slot_of[h] = static_cast<std::int32_t>(sums.size());
+                sums.emplace_back(Eigen::Vector3d::Zero());
+                totals.push_back(0.0);
+            }
+            last_key = key;
+            last_v = static_cast<std::size_t>(slot_of[h]);
         }
-        const auto v = static_cast<std::size_t>(slot_of[h]);
+        const std::size_t v = last_v;
         const double w = weights ? (*weights)[i] : 1.0;
         sums[v] += w * points[i].cast<double>();
         totals[v] += w;
@@ -77,58 +83,62 @@ WeightedVoxels VoxelGrid(const Points& points, const std::vector<float>* weights
     return out;
 }
 
+// A cloud regridded, with the voxel edge it was regridded at.
+struct Regridded {
+    Points points;
+    double voxel_m = 0.0;
+};
+
 // Returns `base` regridded at the config's voxel, or coarser so that it stays near max_points
 // (surface samples scale with 1 / voxel²).
-Points ReduceVoxels(const WeightedVoxels& base, double base_voxel_m,
-                    const RegistrationCloudConfig& config) {
+Regridded ReduceVoxels(const WeightedVoxels& base, double base_voxel_m,
+                       const RegistrationCloudConfig& config) {
+    double voxel = std::max(config.voxel_m, base_voxel_m);
     WeightedVoxels v = config.voxel_m > base_voxel_m
                            ? VoxelGrid(base.centroids, &base.weights, config.voxel_m)
                            : base;
     if (v.centroids.size() > static_cast<std::size_t>(config.max_points)) {
-        const double grow = std::sqrt(static_cast<double>(v.centroids.size()) / config.max_points);
-        v = VoxelGrid(base.centroids, &base.weights, std::max(config.voxel_m, base_voxel_m) * grow);
+        voxel *= std::sqrt(static_cast<double>(v.centroids.size()) / config.max_points);
+        v = VoxelGrid(base.centroids, &base.weights, voxel);
     }
-    return std::move(v.centroids);
+    return {std::move(v.centroids), voxel};
 }
 
-// The k nearest neighbours of every point of a cloud (each point first, at distance 0), from
-// PCL's kd-tree (FLANN). Only this tree is taken from PCL: its filter and feature classes would
-// each build their own tree, and their libraries cost the process ~90,000 symbol relocations
-// at every start, more than everything else boxd links together.
+// The k nearest neighbours of the points of a cloud (each point first, at distance 0), on a
+// grid of cells twice the cloud's voxel: a voxelised surface holds a point every voxel or so,
+// so ten neighbours lie within about two voxels and a query reads 27 cells.
 class Neighbours {
 public:
-    explicit Neighbours(const Points& points) : cloud_(new pcl::PointCloud<pcl::PointXYZ>) {
-        cloud_->reserve(points.size());
-        for (const auto& p : points) cloud_->push_back(pcl::PointXYZ(p.x(), p.y(), p.z()));
-        tree_.setSortedResults(true);
-        tree_.setInputCloud(cloud_);
-    }
+    Neighbours(const Points& points, double voxel_m)
+        : points_(points), grid_(points, static_cast<float>(2.0 * voxel_m)) {}
 
-    // Fills `index` and `sqr_dist` with the k nearest neighbours of point i; returns how many.
+    // Finds the k nearest neighbours of point i; returns how many there are.
     int Of(std::size_t i, int k) {
-        return tree_.nearestKSearch(static_cast<pcl::index_t>(i), k, index_, sqr_dist_);
+        grid_.KNearest(points_[i], k, &found_);
+        return static_cast<int>(found_.size());
     }
-    const pcl::Indices& index() const { return index_; }
-    const std::vector<float>& sqr_dist() const { return sqr_dist_; }
+    float sqr_dist(int j) const { return found_[static_cast<std::size_t>(j)].sqr_dist; }
+    std::size_t index(int j) const {
+        return static_cast<std::size_t>(found_[static_cast<std::size_t>(j)].index);
+    }
 
 private:
-    pcl::PointCloud<pcl::PointXYZ>::Ptr cloud_;
-    pcl::KdTreeFLANN<pcl::PointXYZ> tree_;
-    pcl::Indices index_;
-    std::vector<float> sqr_dist_;
+    const Points& points_;
+    NearestGrid grid_;
+    std::vector<NearestGrid::Neighbour> found_;
 };
 
 // Statistical outlier removal (Rusu et al. 2008): a point whose mean distance to its k nearest
 // neighbours exceeds the mean of those distances by more than `std_ratio` standard deviations
 // (over the whole cloud) is an outlier. Returns the kept points in their order.
-Points RemoveStatisticalOutliers(const Points& points, int k, double std_ratio) {
-    Neighbours near(points);
+Points RemoveStatisticalOutliers(const Points& points, double voxel_m, int k, double std_ratio) {
+    Neighbours near(points, voxel_m);
     std::vector<double> mean_dist(points.size(), 0.0);
     double sum = 0.0, sum_sq = 0.0;
     for (std::size_t i = 0; i < points.size(); ++i) {
         const int found = near.Of(i, k + 1);
         double d = 0.0;
-        for (int j = 1; j < found; ++j) d += std::sqrt(near.sqr_dist()[static_cast<std::size_t>(j)]);
+        for (int j = 1; j < found; ++j) d += std::sqrt(near.sqr_dist(j));
         mean_dist[i] = found > 1 ? d / (found - 1) : 0.0;
         sum += mean_dist[i];
         sum_sq += mean_dist[i] * mean_dist[i];
@@ -152,13 +162,13 @@ struct LocalPlane {
     double variation = 0.0;
 };
 
-LocalPlane FitLocalPlane(const Points& points, const pcl::Indices& index, int count) {
+LocalPlane FitLocalPlane(const Points& points, const Neighbours& near, int count) {
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int j = 0; j < count; ++j) mean += points[static_cast<std::size_t>(index[j])].cast<double>();
+    for (int j = 0; j < count; ++j) mean += points[near.index(j)].cast<double>();
     mean /= count;
     Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
     for (int j = 0; j < count; ++j) {
-        const Eigen::Vector3d d = points[static_cast<std::size_t>(index[j])].cast<double>() - mean;
+        const Eigen::Vector3d d = points[near.index(j)].cast<double>() - mean;
         scatter += d * d.transpose();
     }
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
@@ -170,23 +180,26 @@ LocalPlane FitLocalPlane(const Points& points, const pcl::Indices& index, int co
 }
 
 // Statistical outlier removal and normals of the voxel centroids, facing `viewpoint`.
-OrientedPoints Orient(const Points& voxels, const RegistrationCloudConfig& config,
+OrientedPoints Orient(const Regridded& regridded, const RegistrationCloudConfig& config,
                       const Eigen::Vector3f& viewpoint) {
+    const Points& voxels = regridded.points;
+    const double voxel_m = regridded.voxel_m;
     OrientedPoints out;
     const auto normal_k = static_cast<std::size_t>(config.normal_neighbors);
     if (voxels.size() < normal_k + 1) return out;
     const Points cloud =
         config.outlier_neighbors > 0
-            ? RemoveStatisticalOutliers(voxels, config.outlier_neighbors, config.outlier_std_ratio)
+            ? RemoveStatisticalOutliers(voxels, voxel_m, config.outlier_neighbors,
+                                        config.outlier_std_ratio)
             : voxels;
     if (cloud.size() < normal_k + 1) return out;
-    Neighbours near(cloud);
+    Neighbours near(cloud, voxel_m);
     out.points.reserve(cloud.size());
     out.normals.reserve(cloud.size());
     for (std::size_t i = 0; i < cloud.size(); ++i) {
         const int found = near.Of(i, config.normal_neighbors);
         if (found < 3) continue;
-        const LocalPlane plane = FitLocalPlane(cloud, near.index(), found);
+        const LocalPlane plane = FitLocalPlane(cloud, near, found);
         if (!plane.normal.allFinite() || plane.variation > config.max_surface_variation) continue;
         Eigen::Vector3f normal = plane.normal;
         if (normal.dot(viewpoint - cloud[i]) < 0.0f) normal = -normal;

@@ -36,4 +36,9 @@ int Fail(const Error& error);
 // Routes logs to stderr; the level comes from BOXD_LOG_LEVEL (trace..critical, default info).
 void SetupLogging();
 
+// For a one-shot measurement: keeps freed memory in the process's heap. A session's frames and
+// depth maps are hundreds of buffers of 0.3-1.2 MB; glibc would map each from the kernel and
+// return it when freed, so every one of them would cost its page faults anew.
+void KeepFreedBuffers();
+
 }  // namespace boxd::cli

@@ -85,6 +85,7 @@ double CpuSeconds() {
 }
 
 int RunBench(const BenchOptions& opt) {
+    KeepFreedBuffers();
     const double startup_ms = StartupMs();
     const auto t0 = Clock::now();
     auto session = LoadSession(opt.session);

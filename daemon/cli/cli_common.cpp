@@ -2,6 +2,8 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <malloc.h>
+
 #include <cstdio>
 #include <cstdlib>
 
@@ -24,6 +26,11 @@ void SetupLogging() {
     spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ %v");
     const char* level = std::getenv("BOXD_LOG_LEVEL");
     spdlog::set_level(level ? spdlog::level::from_str(level) : spdlog::level::info);
+}
+
+void KeepFreedBuffers() {
+    mallopt(M_MMAP_THRESHOLD, 256 << 20);
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
 }
 
 }  // namespace boxd::cli

@@ -29,6 +29,7 @@ int RunMeasure(const MeasureOptions& opt) {
             return Fail(Error{ErrorCode::kInvalidInput, "--parcel-id " + s.error().message});
         }
     }
+    KeepFreedBuffers();
     auto session = LoadSession(opt.session);
     if (!session) return Fail(session.error());
     if (!opt.calibration.empty()) {
