@@ -2,12 +2,17 @@
 
 #include <png.h>
 
+#include <algorithm>
+#include <cstdint>
+
 #include <bit>
 #include <csetjmp>
 #include <cstdio>
 #include <memory>
 #include <string>
 #include <vector>
+
+#include "pipeline/png16_decode.h"
 
 namespace boxd {
 
@@ -102,26 +107,69 @@ const char* WriteFrom(std::FILE* f, const DepthImage& image, int compression,
 
 }  // namespace
 
-Result<DepthImage> ReadPng16(const std::filesystem::path& path, int width, int height) {
-    File f(std::fopen(path.c_str(), "rb"));
-    if (!f) return Error{ErrorCode::kInvalidInput, kUnreadable};
+namespace {
+
+Error WrongSize(std::uint32_t header_w, std::uint32_t header_h, int width, int height) {
+    return Error{ErrorCode::kInvalidInput,
+                 "image is " + std::to_string(header_w) + "x" + std::to_string(header_h) +
+                     ", expected " + std::to_string(width) + "x" + std::to_string(height)};
+}
+
+// Reads the whole of `f` into `data` when it is no larger than `limit` bytes; false otherwise.
+bool ReadWhole(std::FILE* f, std::size_t limit, std::vector<std::uint8_t>* data) {
+    data->resize(limit + 1);
+    const std::size_t got = std::fread(data->data(), 1, data->size(), f);
+    if (got > limit || std::ferror(f)) return false;
+    data->resize(got);
+    return true;
+}
+
+// libpng, from the start of `f`: any PNG it reads.
+Result<DepthImage> ReadWithLibpng(std::FILE* f, int width, int height) {
+    std::rewind(f);
     unsigned char signature[8];
-    if (std::fread(signature, 1, sizeof(signature), f.get()) != sizeof(signature) ||
+    if (std::fread(signature, 1, sizeof(signature), f) != sizeof(signature) ||
         png_sig_cmp(signature, 0, sizeof(signature)) != 0) {
         return Error{ErrorCode::kInvalidInput, kUnreadable};
     }
     DepthImage image;
     std::vector<png_bytep> rows;
     png_uint_32 header_w = 0, header_h = 0;
-    if (const char* why = ReadInto(f.get(), width, height, &image, &rows, &header_w, &header_h)) {
-        if (why == kWrongSize) {
-            return Error{ErrorCode::kInvalidInput,
-                         "image is " + std::to_string(header_w) + "x" + std::to_string(header_h) +
-                             ", expected " + std::to_string(width) + "x" + std::to_string(height)};
-        }
+    if (const char* why = ReadInto(f, width, height, &image, &rows, &header_w, &header_h)) {
+        if (why == kWrongSize) return WrongSize(header_w, header_h, width, height);
         return Error{ErrorCode::kInvalidInput, why};
     }
     return image;
+}
+
+}  // namespace
+
+Result<DepthImage> ReadPng16(const std::filesystem::path& path, int width, int height) {
+    File f(std::fopen(path.c_str(), "rb"));
+    if (!f) return Error{ErrorCode::kInvalidInput, kUnreadable};
+    // A frame compresses to well under its raw size; a file far larger than that is left to
+    // libpng's streaming read, which checks the header before anything is allocated.
+    const std::size_t raw = 2u * static_cast<std::size_t>(std::max(width, 0)) *
+                            static_cast<std::size_t>(std::max(height, 0));
+    std::vector<std::uint8_t> data;
+    if (!ReadWhole(f.get(), 2 * raw + (1u << 20), &data)) {
+        return ReadWithLibpng(f.get(), width, height);
+    }
+    DepthImage image;
+    std::uint32_t header_w = 0, header_h = 0;
+    switch (DecodePng16(data.data(), data.size(), width, height, &image, &header_w, &header_h)) {
+        case Png16Decode::kDecoded:
+            return image;
+        case Png16Decode::kBroken:
+            return Error{ErrorCode::kInvalidInput, kUnreadable};
+        case Png16Decode::kWrongKind:
+            return Error{ErrorCode::kInvalidInput, kWrongKind};
+        case Png16Decode::kWrongSize:
+            return WrongSize(header_w, header_h, width, height);
+        case Png16Decode::kOtherForm:
+            break;
+    }
+    return ReadWithLibpng(f.get(), width, height);
 }
 
 Status WritePng16(const std::filesystem::path& path, const DepthImage& image, int compression) {

@@ -16,7 +16,7 @@ PACKAGES=(
     libeigen3-dev libpcl-dev libopencv-dev libceres-dev
     libmodbus-dev libopenni2-dev libusb-1.0-0-dev
     libyaml-cpp-dev nlohmann-json3-dev libcpp-httplib-dev libcli11-dev libspdlog-dev
-    libsqlite3-dev libsystemd-dev libgtest-dev libembree-dev libpng-dev libmosquitto-dev
+    libsqlite3-dev libsystemd-dev libgtest-dev libembree-dev libpng-dev libdeflate-dev libmosquitto-dev
     mosquitto mosquitto-clients
     libjs-three chromium socat curl clang libclang-rt-14-dev python3-jsonschema
 )
