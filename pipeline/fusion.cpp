@@ -30,8 +30,9 @@ FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& p
     all.points.reserve(total);
     all.view.reserve(total);
     for (std::size_t k = 0; k < views.size(); ++k) {
+        const Se2Map move(poses[k]);
         for (const Eigen::Vector3f& p : views[k]) {
-            all.points.push_back(poses[k].Apply(p));
+            all.points.push_back(move(p));
             all.view.push_back(static_cast<std::uint16_t>(k));
         }
     }

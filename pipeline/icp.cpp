@@ -58,10 +58,11 @@ Linearization Linearize(const OrientedPoints& source, const IcpTarget& target, c
     Linearization lin;
     const float max_d = static_cast<float>(config.max_correspondence_m);
     const auto& tgt = target.cloud();
-    const double c = std::cos(t.yaw), sn = std::sin(t.yaw);
+    const Se2Map move(t);
+    const double c = move.c, sn = move.s;
     const double k2 = config.robust_scale_m * config.robust_scale_m;
     for (std::size_t i = 0; i < source.points.size(); ++i) {
-        const Eigen::Vector3f pt = t.Apply(source.points[i]);
+        const Eigen::Vector3f pt = move(source.points[i]);
         const int j = target.Nearest(pt, max_d);
         if (j < 0) continue;
         const Eigen::Vector3d n = tgt.normals[static_cast<std::size_t>(j)].cast<double>();
