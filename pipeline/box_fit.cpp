@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
-#include <unordered_map>
 #include <vector>
+
+#include "pipeline/key_index.h"
+#include "pipeline/parallel_for.h"
 
 namespace boxd {
 
@@ -48,25 +50,33 @@ Eigen::Vector2d FaceNormal(double yaw, int face) {
 // Returns the footprint seed: the minimal-area rectangle of the occupied footprint cells.
 Result<BoxState> SeedFootprint(const Points& points, const BoxFitConfig& config) {
     const double inv = 1.0 / config.footprint_cell_m;
-    std::unordered_map<std::int64_t, int> cells;
+    KeyIndex index;
+    std::vector<std::int64_t> cell_key;  // by dense index
+    std::vector<int> count;
     for (const Eigen::Vector3f& p : points) {
         if (p.z() < config.footprint_min_z_m) continue;
         const auto ix = static_cast<std::int64_t>(std::floor(p.x() * inv));
         const auto iy = static_cast<std::int64_t>(std::floor(p.y() * inv));
-        ++cells[(ix << 32) ^ (iy & 0xFFFFFFFF)];
+        const std::int64_t key = (ix << 32) ^ (iy & 0xFFFFFFFF);
+        const std::size_t c = index.Find(static_cast<std::uint64_t>(key));
+        if (c == count.size()) {
+            cell_key.push_back(key);
+            count.push_back(0);
+        }
+        ++count[c];
     }
     std::vector<cv::Point2f> centres;
-    for (const auto& [key, count] : cells) {
-        if (count < config.footprint_min_cell_points) continue;
-        const auto ix = static_cast<double>(key >> 32);
-        const auto iy = static_cast<double>(static_cast<std::int32_t>(key & 0xFFFFFFFF));
+    for (std::size_t c = 0; c < count.size(); ++c) {
+        if (count[c] < config.footprint_min_cell_points) continue;
+        const auto ix = static_cast<double>(cell_key[c] >> 32);
+        const auto iy = static_cast<double>(static_cast<std::int32_t>(cell_key[c] & 0xFFFFFFFF));
         centres.emplace_back(static_cast<float>((ix + 0.5) * config.footprint_cell_m),
                              static_cast<float>((iy + 0.5) * config.footprint_cell_m));
     }
     if (centres.size() < 3) {
         return Error{ErrorCode::kObjectTooSmall, "the object's footprint is too small to measure"};
     }
-    // Order-independent input for minAreaRect: sort the centres (the hash map order is not).
+    // Order-independent input for minAreaRect: sort the centres (first-seen order is not).
     std::sort(centres.begin(), centres.end(), [](const cv::Point2f& a, const cv::Point2f& b) {
         return a.x < b.x || (a.x == b.x && a.y < b.y);
     });
@@ -105,21 +115,25 @@ bool FitSides(const Points& points, const BoxFitConfig& config, const std::array
     const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);
     const double m = config.edge_margin_m;
     const double zlo = m, zhi = s.height - m;
-    std::vector<FacePoint> sel;
-    for (const Eigen::Vector3f& p3 : points) {
-        if (p3.z() < zlo || p3.z() > zhi) continue;
-        const Eigen::Vector2d p = p3.head<2>().cast<double>();
-        const double u = n[0].dot(p) - cu, v = n[2].dot(p) - cv;
-        for (int f = 0; f < 4; ++f) {
-            const auto k = static_cast<std::size_t>(f);
-            const double r = n[k].dot(p) - s.d[k];
-            if (std::abs(r) > band[k]) continue;
-            const double along = f < 2 ? v : u;
-            const double half = f < 2 ? half_v : half_u;
-            if (std::abs(along) > half - m) continue;
-            sel.push_back({f, p});
-        }
-    }
+    const std::vector<FacePoint> sel = ParallelCollect<FacePoint>(
+        points.size(), config.threads,
+        [&](std::size_t begin, std::size_t end, std::vector<FacePoint>& out) {
+            for (std::size_t i = begin; i < end; ++i) {
+                const Eigen::Vector3f& p3 = points[i];
+                if (p3.z() < zlo || p3.z() > zhi) continue;
+                const Eigen::Vector2d p = p3.head<2>().cast<double>();
+                const double u = n[0].dot(p) - cu, v = n[2].dot(p) - cv;
+                for (int f = 0; f < 4; ++f) {
+                    const auto k = static_cast<std::size_t>(f);
+                    const double r = n[k].dot(p) - s.d[k];
+                    if (std::abs(r) > band[k]) continue;
+                    const double along = f < 2 ? v : u;
+                    const double half = f < 2 ? half_v : half_u;
+                    if (std::abs(along) > half - m) continue;
+                    out.push_back({f, p});
+                }
+            }
+        });
     auto solve = [&](const std::vector<char>& use, std::array<int, 5>& cnt) {
         // Unknowns: dyaw, dd0..dd3. r + (n'·p) dyaw - dd_f = 0.
         Eigen::Matrix<double, 5, 5> h = Eigen::Matrix<double, 5, 5>::Zero();
@@ -130,11 +144,15 @@ bool FitSides(const Points& points, const BoxFitConfig& config, const std::array
             const auto k = static_cast<std::size_t>(sel[i].face);
             const Eigen::Vector2d nd(-n[k].y(), n[k].x());
             const double r = n[k].dot(sel[i].xy) - s.d[k];
-            Eigen::Matrix<double, 5, 1> j = Eigen::Matrix<double, 5, 1>::Zero();
-            j(0) = nd.dot(sel[i].xy);
-            j(1 + static_cast<long>(k)) = -1.0;
-            h += j * j.transpose();
-            g += j * r;
+            // The Jacobian row has two entries, j0 and -1 at 1 + k: only the terms they touch
+            // (h is symmetric; its lower triangle is all ldlt reads).
+            const double j0 = nd.dot(sel[i].xy);
+            const long f = 1 + static_cast<long>(k);
+            h(0, 0) += j0 * j0;
+            h(f, 0) -= j0;
+            h(f, f) += 1.0;
+            g(0) += j0 * r;
+            g(f) -= r;
             ++cnt[k];
         }
         h.diagonal().array() += 1e-12;
@@ -153,7 +171,11 @@ bool FitSides(const Points& points, const BoxFitConfig& config, const std::array
         res[k].push_back(r_all[i]);
     }
     std::array<double, 4> sig{};
-    for (std::size_t k = 0; k < 4; ++k) sig[k] = std::max(RobustSigma(res[k]), 1e-4);
+    // Four medians of tens of thousands of residuals each: the bulk of the fit's time.
+    ParallelFor(4, config.threads, [&](int f) {
+        const auto k = static_cast<std::size_t>(f);
+        sig[k] = std::max(RobustSigma(res[k]), 1e-4);
+    });
     for (std::size_t i = 0; i < sel.size(); ++i) {
         const auto k = static_cast<std::size_t>(sel[i].face);
         use[i] = std::abs(r_all[i]) <= config.trim_sigmas * sig[k];
@@ -179,15 +201,20 @@ bool FitTop(const Points& points, const BoxFitConfig& config, double band, BoxSt
     const double half_u = 0.5 * (s.d[0] + s.d[1]), half_v = 0.5 * (s.d[2] + s.d[3]);
     const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);
     const double m = config.edge_margin_m;
-    std::vector<double> z;
-    for (const Eigen::Vector3f& p3 : points) {
-        if (std::abs(p3.z() - s.height) > band) continue;
-        const Eigen::Vector2d p = p3.head<2>().cast<double>();
-        if (std::abs(nu.dot(p) - cu) > half_u - m || std::abs(nv.dot(p) - cv) > half_v - m) {
-            continue;
-        }
-        z.push_back(p3.z());
-    }
+    const std::vector<double> z = ParallelCollect<double>(
+        points.size(), config.threads,
+        [&](std::size_t begin, std::size_t end, std::vector<double>& out) {
+            for (std::size_t i = begin; i < end; ++i) {
+                const Eigen::Vector3f& p3 = points[i];
+                if (std::abs(p3.z() - s.height) > band) continue;
+                const Eigen::Vector2d p = p3.head<2>().cast<double>();
+                if (std::abs(nu.dot(p) - cu) > half_u - m ||
+                    std::abs(nv.dot(p) - cv) > half_v - m) {
+                    continue;
+                }
+                out.push_back(p3.z());
+            }
+        });
     if (static_cast<int>(z.size()) < config.min_face_points) {
         counts[4] = static_cast<int>(z.size());
         return false;
@@ -231,6 +258,7 @@ Status BoxFitConfig::Validate() const {
     if (!(trim_sigmas >= 1.0)) return Bad("trim_sigmas", "must be >= 1");
     if (iterations < 1 || iterations > 50) return Bad("iterations", "must be in 1..50");
     if (min_face_points < 3) return Bad("min_face_points", "must be >= 3");
+    if (threads < 1 || threads > 64) return Bad("threads", "must be in 1..64");
     return OkStatus();
 }
 

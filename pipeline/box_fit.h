@@ -25,6 +25,7 @@ struct BoxFitConfig {
     double trim_sigmas = 2.5;      // face points beyond this many robust sigmas are outliers
     int iterations = 5;
     int min_face_points = 40;
+    int threads = 2;  // for the passes over the cloud
 
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;

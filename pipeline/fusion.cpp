@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_map>
+
+#include "pipeline/key_index.h"
 
 namespace boxd {
 
@@ -37,12 +38,15 @@ FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& p
         }
     }
     const float inv = static_cast<float>(1.0 / config.support_voxel_m);
-    std::vector<std::uint64_t> keys(all.points.size());
-    std::unordered_map<std::uint64_t, int> counts;
-    counts.reserve(all.points.size() / 4 + 16);
+    // Each point's voxel (a dense index) and each voxel's point count.
+    std::vector<std::uint32_t> voxel(all.points.size());
+    std::vector<int> counts;
+    KeyIndex index;
     for (std::size_t i = 0; i < all.points.size(); ++i) {
-        keys[i] = VoxelKey(all.points[i], inv);
-        ++counts[keys[i]];
+        const std::size_t v = index.Find(VoxelKey(all.points[i], inv));
+        if (v == counts.size()) counts.push_back(0);
+        ++counts[v];
+        voxel[i] = static_cast<std::uint32_t>(v);
     }
     // With fewer than four views most of the surface is seen by a single view, at the fusion
     // stride about one point per support voxel: the support test would remove the object itself.
@@ -52,7 +56,7 @@ FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& p
     out.points.reserve(all.points.size());
     out.view.reserve(all.points.size());
     for (std::size_t i = 0; i < all.points.size(); ++i) {
-        if (counts[keys[i]] < required) continue;
+        if (counts[voxel[i]] < required) continue;
         out.points.push_back(all.points[i]);
         out.view.push_back(all.view[i]);
     }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "pipeline/key_index.h"
 #include "pipeline/nearest_grid.h"
 
 namespace boxd {
@@ -38,37 +39,26 @@ struct WeightedVoxels {
 };
 
 // Returns the (weighted) centroids of the occupied voxels of size `voxel_m`, in the order the
-// voxels are first met in `points`; `weights` may be null (every point counts once). Voxels are
-// found through an open-addressing hash table: far cheaper than sorting the keys.
+// voxels are first met in `points`; `weights` may be null (every point counts once).
 WeightedVoxels VoxelGrid(const Points& points, const std::vector<float>* weights, double voxel_m) {
     const float inv = static_cast<float>(1.0 / voxel_m);
-    std::size_t capacity = 16;
-    while (capacity < 2 * points.size()) capacity <<= 1;
-    const int shift = 64 - __builtin_ctzll(capacity);
-    std::vector<std::uint64_t> keys(capacity);
-    std::vector<std::int32_t> slot_of(capacity, -1);
+    KeyIndex index;
     std::vector<Eigen::Vector3d> sums;
     std::vector<double> totals;
     // A view's points come in image order, so neighbours in the list mostly share a voxel:
     // the previous point's voxel is checked before the table.
     std::uint64_t last_key = 0;
-    std::size_t last_v = 0;
+    std::size_t v = 0;
     for (std::size_t i = 0; i < points.size(); ++i) {
         const std::uint64_t key = VoxelKey(points[i], inv);
         if (i == 0 || key != last_key) {
-            // Fibonacci hashing (Knuth, TAOCP 6.4), linear probing.
-            std::size_t h = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> shift);
-            while (slot_of[h] >= 0 && keys[h] != key) h = (h + 1) & (capacity - 1);
-            if (slot_of[h] < 0) {
-                keys[h] = key;
-                slot_of[h] = static_cast<std::int32_t>(sums.size());
+            v = index.Find(key);
+            if (v == sums.size()) {
                 sums.emplace_back(Eigen::Vector3d::Zero());
                 totals.push_back(0.0);
             }
             last_key = key;
-            last_v = static_cast<std::size_t>(slot_of[h]);
         }
-        const std::size_t v = last_v;
         const double w = weights ? (*weights)[i] : 1.0;
         sums[v] += w * points[i].cast<double>();
         totals[v] += w;
@@ -76,9 +66,9 @@ WeightedVoxels VoxelGrid(const Points& points, const std::vector<float>* weights
     WeightedVoxels out;
     out.centroids.reserve(sums.size());
     out.weights.reserve(sums.size());
-    for (std::size_t v = 0; v < sums.size(); ++v) {
-        out.centroids.push_back((sums[v] / totals[v]).cast<float>());
-        out.weights.push_back(static_cast<float>(totals[v]));
+    for (std::size_t c = 0; c < sums.size(); ++c) {
+        out.centroids.push_back((sums[c] / totals[c]).cast<float>());
+        out.weights.push_back(static_cast<float>(totals[c]));
     }
     return out;
 }

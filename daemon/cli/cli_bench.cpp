@@ -96,6 +96,7 @@ int RunBench(const BenchOptions& opt) {
     MeasureConfig config;
     config.threads = opt.threads;
     config.registration.threads = opt.threads;
+    config.box_fit.threads = opt.threads;
     std::vector<double> wall;
     std::map<std::string, std::vector<double>> stages;
     std::string status;
