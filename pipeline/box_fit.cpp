@@ -25,12 +25,17 @@ double Median(std::vector<double> v) {
     return *mid;
 }
 
-// 1.4826 * MAD: the standard deviation of normally distributed residuals.
-double RobustSigma(const std::vector<double>& residuals) {
-    std::vector<double> a(residuals.size());
-    const double m = Median(residuals);
-    for (std::size_t i = 0; i < a.size(); ++i) a[i] = std::abs(residuals[i] - m);
+// 1.4826 * the median absolute deviation from `center`: the standard deviation of normally
+// distributed values about it.
+double MadSigma(const std::vector<double>& values, double center) {
+    std::vector<double> a(values.size());
+    for (std::size_t i = 0; i < a.size(); ++i) a[i] = std::abs(values[i] - center);
     return 1.4826 * Median(std::move(a));
+}
+
+// The same about the residuals' own median.
+double RobustSigma(const std::vector<double>& residuals) {
+    return MadSigma(residuals, Median(residuals));
 }
 
 // The box in its own footprint frame: u along `yaw`, v perpendicular, origin at the table.
@@ -220,9 +225,7 @@ bool FitTop(const Points& points, const BoxFitConfig& config, double band, BoxSt
         return false;
     }
     const double med = Median(z);
-    std::vector<double> r(z.size());
-    for (std::size_t i = 0; i < z.size(); ++i) r[i] = z[i] - med;
-    const double sig = std::max(RobustSigma(r), 1e-4);
+    const double sig = std::max(MadSigma(z, med), 1e-4);
     double sum = 0.0;
     int n = 0;
     for (double v : z) {

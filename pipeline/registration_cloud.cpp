@@ -94,71 +94,67 @@ Regridded ReduceVoxels(const WeightedVoxels& base, double base_voxel_m,
     return {std::move(v.centroids), voxel};
 }
 
-// The k nearest neighbours of the points of a cloud (each point first, at distance 0), on a
-// grid of cells twice the cloud's voxel: a voxelised surface holds a point every voxel or so,
-// so ten neighbours lie within about two voxels and a query reads 27 cells.
-class Neighbours {
-public:
-    Neighbours(const Points& points, double voxel_m)
-        : points_(points), grid_(points, static_cast<float>(2.0 * voxel_m)) {}
-
-    // Finds the k nearest neighbours of point i; returns how many there are.
-    int Of(std::size_t i, int k) {
-        grid_.KNearest(points_[i], k, &found_);
-        return static_cast<int>(found_.size());
-    }
-    float sqr_dist(int j) const { return found_[static_cast<std::size_t>(j)].sqr_dist; }
-    std::size_t index(int j) const {
-        return static_cast<std::size_t>(found_[static_cast<std::size_t>(j)].index);
-    }
-
-private:
-    const Points& points_;
-    NearestGrid grid_;
-    std::vector<NearestGrid::Neighbour> found_;
-};
+using Neighbour = NearestGrid::Neighbour;
 
 // Statistical outlier removal (Rusu et al. 2008): a point whose mean distance to its k nearest
 // neighbours exceeds the mean of those distances by more than `std_ratio` standard deviations
-// (over the whole cloud) is an outlier. Returns the kept points in their order.
-Points RemoveStatisticalOutliers(const Points& points, double voxel_m, int k, double std_ratio) {
-    Neighbours near(points, voxel_m);
-    std::vector<double> mean_dist(points.size(), 0.0);
+// (over the whole cloud) is an outlier. `near[i]` lists point i's nearest neighbours, itself
+// first, at least k + 1 of them when the cloud has them. Returns which points are kept.
+std::vector<char> StatisticalInliers(const std::vector<std::vector<Neighbour>>& near, int k,
+                                     double std_ratio) {
+    std::vector<double> mean_dist(near.size(), 0.0);
     double sum = 0.0, sum_sq = 0.0;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        const int found = near.Of(i, k + 1);
+    for (std::size_t i = 0; i < near.size(); ++i) {
+        const std::size_t found = std::min(near[i].size(), static_cast<std::size_t>(k) + 1);
         double d = 0.0;
-        for (int j = 1; j < found; ++j) d += std::sqrt(near.sqr_dist(j));
-        mean_dist[i] = found > 1 ? d / (found - 1) : 0.0;
+        for (std::size_t j = 1; j < found; ++j) d += std::sqrt(near[i][j].sqr_dist);
+        mean_dist[i] = found > 1 ? d / static_cast<double>(found - 1) : 0.0;
         sum += mean_dist[i];
         sum_sq += mean_dist[i] * mean_dist[i];
     }
-    const double n = static_cast<double>(points.size());
+    const double n = static_cast<double>(near.size());
     const double mean = sum / n;
     const double variance = n > 1.0 ? std::max(0.0, (sum_sq - sum * sum / n) / (n - 1.0)) : 0.0;
     const double threshold = mean + std_ratio * std::sqrt(variance);
-    Points kept;
-    kept.reserve(points.size());
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        if (mean_dist[i] <= threshold) kept.push_back(points[i]);
-    }
+    std::vector<char> kept(near.size());
+    for (std::size_t i = 0; i < near.size(); ++i) kept[i] = mean_dist[i] <= threshold ? 1 : 0;
     return kept;
 }
 
-// The normal of a point's neighbourhood (the least-variance axis of its scatter, in double
-// about its mean) and its surface variation λ0 / (λ0 + λ1 + λ2) (Pauly et al. 2002).
+// Returns the k nearest kept points to point i (nearest first), from its list `near` when that
+// holds enough of them: the list is the nearest points of the whole cloud, so its kept ones
+// are the nearest kept ones. Otherwise the grid is asked for longer lists until it does.
+std::vector<Neighbour> NearestKept(const NearestGrid& grid, const Points& points, std::size_t i,
+                                   std::vector<Neighbour> near, const std::vector<char>& kept,
+                                   std::size_t k) {
+    if (near.empty()) return near;  // a point that is not finite: nobody's neighbour
+    for (std::size_t ask = near.size();;) {
+        std::vector<Neighbour> out;
+        for (const Neighbour& n : near) {
+            if (out.size() < k && kept[static_cast<std::size_t>(n.index)]) out.push_back(n);
+        }
+        // Enough, or the list already holds every point of the cloud.
+        if (out.size() == k || near.size() < ask) return out;
+        ask *= 2;
+        grid.KNearest(points[i], static_cast<int>(ask), &near);
+    }
+}
+
+// The normal of a neighbourhood (the least-variance axis of its scatter, in double about its
+// mean) and its surface variation λ0 / (λ0 + λ1 + λ2) (Pauly et al. 2002).
 struct LocalPlane {
     Eigen::Vector3f normal;
     double variation = 0.0;
 };
 
-LocalPlane FitLocalPlane(const Points& points, const Neighbours& near, int count) {
+LocalPlane FitLocalPlane(const Points& points, const std::vector<Neighbour>& near) {
+    const auto count = static_cast<double>(near.size());
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int j = 0; j < count; ++j) mean += points[near.index(j)].cast<double>();
+    for (const Neighbour& n : near) mean += points[static_cast<std::size_t>(n.index)].cast<double>();
     mean /= count;
     Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-    for (int j = 0; j < count; ++j) {
-        const Eigen::Vector3d d = points[near.index(j)].cast<double>() - mean;
+    for (const Neighbour& n : near) {
+        const Eigen::Vector3d d = points[static_cast<std::size_t>(n.index)].cast<double>() - mean;
         scatter += d * d.transpose();
     }
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
@@ -169,31 +165,37 @@ LocalPlane FitLocalPlane(const Points& points, const Neighbours& near, int count
             total > 0.0 ? lambda[0] / total : 0.0};
 }
 
-// Statistical outlier removal and normals of the voxel centroids, facing `viewpoint`.
+// Statistical outlier removal and normals of the voxel centroids, facing `viewpoint`: the
+// normals of the kept points from their nearest kept neighbours. One neighbour search serves
+// both, on a grid of cells twice the voxel (a voxelised surface holds a point every voxel or
+// so: ten neighbours lie within about two voxels, and a query reads 27 cells).
 OrientedPoints Orient(const Regridded& regridded, const RegistrationCloudConfig& config,
                       const Eigen::Vector3f& viewpoint) {
     const Points& voxels = regridded.points;
-    const double voxel_m = regridded.voxel_m;
     OrientedPoints out;
     const auto normal_k = static_cast<std::size_t>(config.normal_neighbors);
     if (voxels.size() < normal_k + 1) return out;
-    const Points cloud =
+    const NearestGrid grid(voxels, static_cast<float>(2.0 * regridded.voxel_m));
+    const int ask = std::max(config.normal_neighbors, config.outlier_neighbors + 1);
+    std::vector<std::vector<Neighbour>> near(voxels.size());
+    for (std::size_t i = 0; i < voxels.size(); ++i) grid.KNearest(voxels[i], ask, &near[i]);
+    const std::vector<char> kept =
         config.outlier_neighbors > 0
-            ? RemoveStatisticalOutliers(voxels, voxel_m, config.outlier_neighbors,
-                                        config.outlier_std_ratio)
-            : voxels;
-    if (cloud.size() < normal_k + 1) return out;
-    Neighbours near(cloud, voxel_m);
-    out.points.reserve(cloud.size());
-    out.normals.reserve(cloud.size());
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-        const int found = near.Of(i, config.normal_neighbors);
-        if (found < 3) continue;
-        const LocalPlane plane = FitLocalPlane(cloud, near, found);
+            ? StatisticalInliers(near, config.outlier_neighbors, config.outlier_std_ratio)
+            : std::vector<char>(voxels.size(), 1);
+    if (static_cast<std::size_t>(std::count(kept.begin(), kept.end(), 1)) < normal_k + 1) {
+        return out;
+    }
+    for (std::size_t i = 0; i < voxels.size(); ++i) {
+        if (!kept[i]) continue;
+        const std::vector<Neighbour> hood =
+            NearestKept(grid, voxels, i, std::move(near[i]), kept, normal_k);
+        if (hood.size() < 3) continue;
+        const LocalPlane plane = FitLocalPlane(voxels, hood);
         if (!plane.normal.allFinite() || plane.variation > config.max_surface_variation) continue;
         Eigen::Vector3f normal = plane.normal;
-        if (normal.dot(viewpoint - cloud[i]) < 0.0f) normal = -normal;
-        out.points.push_back(cloud[i]);
+        if (normal.dot(viewpoint - voxels[i]) < 0.0f) normal = -normal;
+        out.points.push_back(voxels[i]);
         out.normals.push_back(normal);
     }
     return out;

@@ -101,18 +101,26 @@ std::unique_ptr<ViewStream> ViewStream::SoFar() const {
     return copy;
 }
 
-bool ViewStream::Accept(std::size_t k, PreparedPose pose) {
-    auto depth = UsableDepth(std::move(pose), k, config_.refusal);
-    if (!depth) {
-        unusable_ = depth.error();
-        return false;
-    }
+ViewStream::Inspected ViewStream::Inspect(std::size_t k, PreparedPose pose) const {
+    Inspected out;
+    out.depth = UsableDepth(std::move(pose), k, config_.refusal);
+    if (!out.depth) return out;
     const std::size_t share = std::max<std::size_t>(
         100, std::min(kCandidatesPerPose,
                       kCandidatesInAll / std::max<std::size_t>(1, plan_deg_.size())));
-    candidates_[k] = EvenSubsample(
-        TableCandidates(*depth, header_.camera, header_.calibration, config_.table_plane), share);
-    pending_.push_back(std::move(*depth));
+    out.candidates = EvenSubsample(
+        TableCandidates(*out.depth, header_.camera, header_.calibration, config_.table_plane),
+        share);
+    return out;
+}
+
+bool ViewStream::Accept(std::size_t k, Inspected pose) {
+    if (!pose.depth) {
+        unusable_ = pose.depth.error();
+        return false;
+    }
+    candidates_[k] = std::move(pose.candidates);
+    pending_.push_back(std::move(*pose.depth));
     return true;
 }
 
@@ -151,9 +159,16 @@ void ViewStream::AddAll(std::vector<PreparedPose> poses) {
     added_ += n;
     // Each pose in order: checked, its table candidates, and the provisional table once they
     // locate it — the same sequence whether the poses come one by one or all at once.
+    std::vector<Inspected> inspected(static_cast<std::size_t>(n));
+    ParallelFor(n, config_.threads, [&](int i) {
+        const auto k = static_cast<std::size_t>(i);
+        inspected[k] = Inspect(static_cast<std::size_t>(first + i), std::move(poses[k]));
+    });
     for (int i = 0; i < n && !Blocked(); ++i) {
-        if (!Accept(static_cast<std::size_t>(first + i), std::move(poses[static_cast<std::size_t>(i)])))
+        if (!Accept(static_cast<std::size_t>(first + i),
+                    std::move(inspected[static_cast<std::size_t>(i)]))) {
             break;
+        }
         TryTable();
     }
     if (Blocked() || !provisional_) {

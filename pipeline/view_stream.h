@@ -73,8 +73,15 @@ public:
     double align_ms() const { return align_ms_; }
 
 private:
-    // Takes pose k (its depth checked, its table candidates kept); false when it is unusable.
-    bool Accept(std::size_t k, PreparedPose pose);
+    // A pose looked at before it is taken: its depth (or why it is unusable) and its table
+    // candidates. Poses are inspected on the worker threads, then taken in order.
+    struct Inspected {
+        Result<DepthMap> depth = DepthMap{};
+        std::vector<Eigen::Vector3d> candidates;
+    };
+    Inspected Inspect(std::size_t k, PreparedPose pose) const;
+    // Takes pose k (its depth, its table candidates); false when it is unusable.
+    bool Accept(std::size_t k, Inspected pose);
     void TryTable();  // the provisional table frame from the candidates so far
     void SegmentInto(std::size_t k, const DepthMap& depth);
     bool Blocked() const { return unusable_.has_value(); }
