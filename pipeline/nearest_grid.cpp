@@ -79,42 +79,26 @@ bool NearestGrid::CellRange(const Eigen::Vector3f& p, float radius,
 
 int NearestGrid::Nearest(const Eigen::Vector3f& p, float max_dist) const {
     if (sorted_.empty() || !p.allFinite() || !(max_dist >= 0.0f)) return -1;
-    std::array<int, 6> c{};
-    if (!CellRange(p, max_dist, &c)) return -1;
     float best = max_dist * max_dist;
     int best_index = -1;
-    for (int z = c[4]; z <= c[5]; ++z) {
-        for (int y = c[2]; y <= c[3]; ++y) {
-            const std::size_t row = (static_cast<std::size_t>(z) * ny_ + y) * nx_;
-            const std::uint32_t end = start_[row + static_cast<std::size_t>(c[1]) + 1];
-            for (std::uint32_t s = start_[row + static_cast<std::size_t>(c[0])]; s < end; ++s) {
-                const float d2 = (sorted_[s] - p).squaredNorm();
-                const int idx = static_cast<int>(index_[s]);
-                if (d2 < best || (d2 == best && (best_index < 0 || idx < best_index))) {
-                    best = d2;
-                    best_index = idx;
-                }
-            }
+    ForEachNear(p, max_dist, [&](std::uint32_t s) {
+        const float d2 = (sorted_[s] - p).squaredNorm();
+        const int idx = static_cast<int>(index_[s]);
+        if (d2 < best || (d2 == best && (best_index < 0 || idx < best_index))) {
+            best = d2;
+            best_index = idx;
         }
-    }
+    });
     return best_index;
 }
 
 void NearestGrid::Within(const Eigen::Vector3f& p, float radius,
                          std::vector<Neighbour>* out) const {
-    std::array<int, 6> c{};
-    if (!CellRange(p, radius, &c)) return;
     const float r2 = radius * radius;
-    for (int z = c[4]; z <= c[5]; ++z) {
-        for (int y = c[2]; y <= c[3]; ++y) {
-            const std::size_t row = (static_cast<std::size_t>(z) * ny_ + y) * nx_;
-            const std::uint32_t end = start_[row + static_cast<std::size_t>(c[1]) + 1];
-            for (std::uint32_t s = start_[row + static_cast<std::size_t>(c[0])]; s < end; ++s) {
-                const float d2 = (sorted_[s] - p).squaredNorm();
-                if (d2 <= r2) out->push_back({d2, static_cast<int>(index_[s])});
-            }
-        }
-    }
+    ForEachNear(p, radius, [&](std::uint32_t s) {
+        const float d2 = (sorted_[s] - p).squaredNorm();
+        if (d2 <= r2) out->push_back({d2, static_cast<int>(index_[s])});
+    });
 }
 
 void NearestGrid::KNearest(const Eigen::Vector3f& p, int k, std::vector<Neighbour>* out) const {

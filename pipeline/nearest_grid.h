@@ -45,6 +45,24 @@ private:
     // The cells overlapping the cube of half-edge `radius` about `p`, clipped to the grid;
     // false when the cube misses the grid.
     bool CellRange(const Eigen::Vector3f& p, float radius, std::array<int, 6>* range) const;
+    // Calls visit(slot) for every point (its slot in sorted_) of the cells CellRange finds.
+    template <typename Visit>
+    void ForEachNear(const Eigen::Vector3f& p, float radius, Visit&& visit) const {
+        std::array<int, 6> c{};
+        if (!CellRange(p, radius, &c)) return;
+        for (int z = c[4]; z <= c[5]; ++z) {
+            for (int y = c[2]; y <= c[3]; ++y) {
+                const std::size_t row =
+                    (static_cast<std::size_t>(z) * static_cast<std::size_t>(ny_) +
+                     static_cast<std::size_t>(y)) *
+                    static_cast<std::size_t>(nx_);
+                const std::uint32_t end = start_[row + static_cast<std::size_t>(c[1]) + 1];
+                for (std::uint32_t s = start_[row + static_cast<std::size_t>(c[0])]; s < end; ++s) {
+                    visit(s);
+                }
+            }
+        }
+    }
 
     Eigen::Vector3f origin_ = Eigen::Vector3f::Zero();
     float cell_ = 0.0f;
