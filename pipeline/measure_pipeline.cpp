@@ -182,15 +182,38 @@ Result<MeasureOutput> MeasureStreamed(const Session& session, ViewStream& stream
     return out;
 }
 
-Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig& config,
-                                     BoxMethod method, const MonotonicMs& clock) {
+namespace {
+
+// MeasurePrepared of the poses `prepare` returns, its time counted in the "preprocess" lap.
+template <typename Prepare>
+Result<MeasureOutput> MeasureAfter(const Session& header, Prepare&& prepare,
+                                   const MeasureConfig& config, BoxMethod method,
+                                   const MonotonicMs& clock) {
     if (Status s = config.Validate(); !s) return s.error();
     StageLaps first_stage(clock);
-    std::vector<PreparedPose> prepared = PrepareSession(session, config);
+    Result<std::vector<PreparedPose>> prepared = prepare();
+    if (!prepared) return prepared.error();
     first_stage.Lap("preprocess");
-    auto out = MeasurePrepared(session, std::move(prepared), config, method, clock);
+    auto out = MeasurePrepared(header, std::move(*prepared), config, method, clock);
     if (out) out->result.timing_ms["preprocess"] += first_stage.ms().at("preprocess");
     return out;
+}
+
+}  // namespace
+
+Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig& config,
+                                     BoxMethod method, const MonotonicMs& clock) {
+    return MeasureAfter(
+        session,
+        [&]() -> Result<std::vector<PreparedPose>> { return PrepareSession(session, config); },
+        config, method, clock);
+}
+
+Result<MeasureOutput> MeasureFromSource(const Session& header, const PoseFrameSource& frames,
+                                        const MeasureConfig& config, BoxMethod method,
+                                        const MonotonicMs& clock) {
+    return MeasureAfter(
+        header, [&] { return PrepareFromSource(header, config, frames); }, config, method, clock);
 }
 
 }  // namespace boxd

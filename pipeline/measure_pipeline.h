@@ -48,4 +48,10 @@ Result<MeasureOutput> MeasureStreamed(const Session& session, ViewStream& stream
 Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig& config,
                                      BoxMethod method, const MonotonicMs& clock = {});
 
+// The same for a session whose frames are not loaded: each pose's come from `frames` as it is
+// prepared (PrepareFromSource), and the first pose whose frames cannot be had is the error.
+Result<MeasureOutput> MeasureFromSource(const Session& header, const PoseFrameSource& frames,
+                                        const MeasureConfig& config, BoxMethod method,
+                                        const MonotonicMs& clock = {});
+
 }  // namespace boxd

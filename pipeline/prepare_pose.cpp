@@ -27,6 +27,26 @@ std::vector<PreparedPose> PrepareSession(const Session& session, const MeasureCo
     return prepared;
 }
 
+Result<std::vector<PreparedPose>> PrepareFromSource(const Session& header,
+                                                    const MeasureConfig& config,
+                                                    const PoseFrameSource& frames) {
+    std::vector<PreparedPose> prepared(header.poses.size());
+    std::vector<std::optional<Error>> errors(header.poses.size());
+    ParallelFor(static_cast<int>(prepared.size()), config.threads, [&](int k) {
+        const auto i = static_cast<std::size_t>(k);
+        auto loaded = frames(i);
+        if (!loaded) {
+            errors[i] = loaded.error();
+            return;
+        }
+        prepared[i] = PreparePose(*loaded, header.camera.depth_unit_m, config);
+    });
+    for (const auto& e : errors) {
+        if (e) return *e;
+    }
+    return prepared;
+}
+
 Result<DepthMap> UsableDepth(PreparedPose pose, std::size_t index, const RefusalConfig& refuse) {
     if (!pose.error.empty()) {
         return Error{ErrorCode::kInsufficientData, fmt::format("pose {}: {}", index, pose.error)};

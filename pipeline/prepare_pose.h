@@ -3,6 +3,8 @@
 // (RemoveFlyingPixels). The only stage that needs nothing but the pose's own frames, so a
 // capture runs it while the table moves on; every later stage needs all poses.
 
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +27,18 @@ PreparedPose PreparePose(const std::vector<DepthImage>& frames, double depth_uni
 
 // Returns every pose of `session` through PreparePose, on config.threads threads.
 std::vector<PreparedPose> PrepareSession(const Session& session, const MeasureConfig& config);
+
+// Where each pose's frames come from when they are not held in the session: the frames of pose
+// i, or why they cannot be had.
+using PoseFrameSource = std::function<Result<std::vector<DepthImage>>(std::size_t pose)>;
+
+// Returns every pose of `header` (whose frames are not loaded) through PreparePose like
+// PrepareSession. Each pose's frames are taken from `frames` by the worker thread that prepares
+// the pose and let go as soon as it is prepared, so a session's frames are never all in memory
+// at once. An error is the first pose's (in pose order) whose frames cannot be had.
+Result<std::vector<PreparedPose>> PrepareFromSource(const Session& header,
+                                                    const MeasureConfig& config,
+                                                    const PoseFrameSource& frames);
 
 // Returns pose `index`'s depth map, or INSUFFICIENT_DATA naming it when it cannot be used (its
 // frames could not be averaged, or too few of its pixels have a reading).

@@ -166,6 +166,20 @@ Result<std::vector<SessionPose>> ParsePoses(const JsonReader& r, const json& roo
     return out;
 }
 
+// Returns frame k of pose i, read from its file under `dir`.
+Result<DepthImage> LoadFrame(const fs::path& dir, const CameraIntrinsics& camera,
+                             const SessionPose& pose, std::size_t i, std::size_t k) {
+    const std::string field = "poses[" + std::to_string(i) + "].frames[" + std::to_string(k) + "]";
+    // Nothing may leave a worker thread as an exception (std::terminate): memory running out
+    // while decoding is this frame's error like any other.
+    try {
+        return ReadFrame(dir / pose.frame_paths[k], field, camera);
+    } catch (const std::exception& e) {
+        return SessionError(dir / pose.frame_paths[k], field,
+                            std::string("cannot be decoded: ") + e.what());
+    }
+}
+
 // Loads every frame of every pose, on two threads (PNG decoding dominates session loading).
 Status LoadFrames(const fs::path& dir, const CameraIntrinsics& camera,
                   std::vector<SessionPose>& poses) {
@@ -181,20 +195,11 @@ Status LoadFrames(const fs::path& dir, const CameraIntrinsics& camera,
     auto work = [&](std::size_t begin, std::size_t step) {
         for (std::size_t j = begin; j < jobs.size(); j += step) {
             const auto [i, k] = jobs[j];
-            const std::string field =
-                "poses[" + std::to_string(i) + "].frames[" + std::to_string(k) + "]";
-            // Nothing may leave a worker thread as an exception (std::terminate): memory running
-            // out while decoding is this frame's error like any other.
-            try {
-                auto img = ReadFrame(dir / poses[i].frame_paths[k], field, camera);
-                if (img) {
-                    poses[i].frames[k] = std::move(*img);
-                } else {
-                    errors[j] = img.error();
-                }
-            } catch (const std::exception& e) {
-                errors[j] = SessionError(dir / poses[i].frame_paths[k], field,
-                                         std::string("cannot be decoded: ") + e.what());
+            auto img = LoadFrame(dir, camera, poses[i], i, k);
+            if (img) {
+                poses[i].frames[k] = std::move(*img);
+            } else {
+                errors[j] = img.error();
             }
         }
     };
@@ -214,6 +219,28 @@ const char* DirectionName(TurntableDirection d) {
 }  // namespace
 
 Result<Session> LoadSession(const fs::path& dir) {
+    auto s = LoadSessionHeader(dir);
+    if (!s) return s.error();
+    if (auto st = LoadFrames(dir, s->camera, s->poses); !st) return st.error();
+    return s;
+}
+
+Result<std::vector<DepthImage>> LoadPoseFrames(const fs::path& dir, const Session& header,
+                                               std::size_t pose) {
+    if (pose >= header.poses.size()) {
+        return Error{ErrorCode::kInternal, "LoadPoseFrames: no pose " + std::to_string(pose)};
+    }
+    const SessionPose& p = header.poses[pose];
+    std::vector<DepthImage> frames(p.frame_paths.size());
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+        auto img = LoadFrame(dir, header.camera, p, pose, k);
+        if (!img) return img.error();
+        frames[k] = std::move(*img);
+    }
+    return frames;
+}
+
+Result<Session> LoadSessionHeader(const fs::path& dir) {
     std::error_code ec;
     if (!fs::is_directory(dir, ec)) {
         return SessionError(dir, "", "session folder not found");
@@ -281,7 +308,6 @@ Result<Session> LoadSession(const fs::path& dir) {
         s.ground_truth = d;
     }
 
-    if (auto st = LoadFrames(dir, s.camera, s.poses); !st) return st.error();
     return s;
 }
 

@@ -30,7 +30,8 @@ int RunMeasure(const MeasureOptions& opt) {
         }
     }
     KeepFreedBuffers();
-    auto session = LoadSession(opt.session);
+    // The frames are read pose by pose as the poses are prepared, not all held at once.
+    auto session = LoadSessionHeader(opt.session);
     if (!session) return Fail(session.error());
     if (!opt.calibration.empty()) {
         // A station recalibrated after the capture: its calibration replaces the session's.
@@ -46,7 +47,10 @@ int RunMeasure(const MeasureOptions& opt) {
     const MonotonicMs clock = SteadyClockMs();
     const std::string started_at = UtcTimestampNow();
     const double start_ms = clock();
-    auto out = MeasureSession(*session, MeasureConfig{}, method, clock);
+    const PoseFrameSource frames = [&](std::size_t pose) {
+        return LoadPoseFrames(opt.session, *session, pose);
+    };
+    auto out = MeasureFromSource(*session, frames, MeasureConfig{}, method, clock);
     if (!out) return Fail(out.error());
     MeasurementResult& result = out->result;
     result.id = "offline";

@@ -1,14 +1,18 @@
-// MeasureSession against MeasurePrepared: a capture that prepares its poses one by one (the
-// daemon, while the table moves) must get the very numbers an offline run gets.
+// MeasureSession against MeasurePrepared and MeasureFromSource: a capture that prepares its
+// poses one by one (the daemon, while the table moves), and `boxd measure` reading each pose's
+// frames as it prepares it, must get the very numbers an offline run of the loaded session gets.
 #include "pipeline/measure_pipeline.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <set>
 #include <string>
 
 #include "drivers/sim/synthetic_station.h"
+#include "pipeline/session_io.h"
+#include "tests/support/temp_dir.h"
 
 namespace boxd {
 namespace {
@@ -48,6 +52,42 @@ TEST(MeasurePrepared, GivesTheNumbersOfMeasureSession) {
     EXPECT_EQ(a.height_m, b.height_m);
     EXPECT_EQ(offline->cloud.size(), streamed->cloud.size());
     EXPECT_NEAR(a.length_m, 0.3, 0.003);
+}
+
+TEST(MeasureFromSource, ReadsThePosesFramesAsItGoesAndGivesTheSameNumbers) {
+    const Session session = SmallSession();
+    test::TempDir dir;
+    ASSERT_TRUE(WriteSession(session, dir.path()).ok());
+    auto loaded = LoadSession(dir.path());
+    ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+    auto header = LoadSessionHeader(dir.path());
+    ASSERT_TRUE(header.ok());
+    for (const SessionPose& pose : header->poses) EXPECT_TRUE(pose.frames.empty());
+    const MeasureConfig config;
+    std::vector<int> asked(session.poses.size(), 0);
+    const PoseFrameSource frames = [&](std::size_t pose) {
+        ++asked[pose];  // each pose by one worker only
+        return LoadPoseFrames(dir.path(), *header, pose);
+    };
+    auto from_files = MeasureFromSource(*header, frames, config, BoxMethod::kFootprint);
+    auto whole = MeasureSession(*loaded, config, BoxMethod::kFootprint);
+    ASSERT_TRUE(from_files.ok() && whole.ok());
+    EXPECT_EQ(asked, std::vector<int>(session.poses.size(), 1));
+    ASSERT_EQ(from_files->result.status, MeasurementStatus::kOk);
+    EXPECT_EQ(from_files->result.dimensions->length_m, whole->result.dimensions->length_m);
+    EXPECT_EQ(from_files->result.dimensions->width_m, whole->result.dimensions->width_m);
+    EXPECT_EQ(from_files->result.dimensions->height_m, whole->result.dimensions->height_m);
+
+    // Two broken frames: the error is the first pose's, as LoadSession reports it.
+    std::ofstream(dir.path() / "pose_005" / "frame_00.png") << "not a png";
+    std::ofstream(dir.path() / "pose_002" / "frame_01.png") << "not a png";
+    auto broken = MeasureFromSource(*header, frames, config, BoxMethod::kFootprint);
+    auto broken_load = LoadSession(dir.path());
+    ASSERT_FALSE(broken.ok());
+    ASSERT_FALSE(broken_load.ok());
+    EXPECT_EQ(broken.error().code, broken_load.error().code);
+    EXPECT_EQ(broken.error().message, broken_load.error().message);
+    EXPECT_NE(broken.error().message.find("pose_002/frame_01.png"), std::string::npos);
 }
 
 TEST(MeasurePrepared, RefusesPosesItCannotUse) {
