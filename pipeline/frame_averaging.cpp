@@ -33,47 +33,56 @@ struct AveragingPass {
 template <std::size_t N>
 void AverageAll(const AveragingPass& pass, DepthMap* out) {
     constexpr std::size_t kBlock = 1024;
-    constexpr std::uint32_t kNone = 0x10000u;  // above every 16-bit reading
-    std::array<std::uint32_t, kBlock> median{}, valid{};
+    constexpr std::int32_t kNone = 0x10000;  // above every 16-bit reading
+    std::array<std::uint32_t, kBlock> median{}, valid{}, tol{}, sums{}, agreeing{};
     const std::size_t count = out->z_m.size();
     for (std::size_t start = 0; start < count; start += kBlock) {
         const std::size_t len = std::min(kBlock, count - start);
+        // Signed 32-bit lanes: SSE2 compares those directly (readings fit in 17 bits).
         for (std::size_t p = 0; p < len; ++p) {
-            std::array<std::uint32_t, N> r{};
-            std::uint32_t k = 0;
+            std::array<std::int32_t, N> r{};
+            std::int32_t k = 0;
             for (std::size_t f = 0; f < N; ++f) {
-                const std::uint32_t v = pass.src[f][start + p];
-                k += v != 0 ? 1u : 0u;
+                const std::int32_t v = pass.src[f][start + p];
+                k += v != 0 ? 1 : 0;
                 r[f] = v != 0 ? v : kNone;
             }
-            const std::uint32_t m = (k > 0 ? k - 1 : 0) / 2;
-            std::uint32_t med = 0;
+            const std::int32_t m = (k > 0 ? k - 1 : 0) / 2;
+            std::int32_t med = 0;
             for (std::size_t a = 0; a < N; ++a) {
-                std::uint32_t rank = 0;
+                std::int32_t rank = 0;
                 for (std::size_t b = 0; b < N; ++b) {
-                    rank += (r[b] < r[a] || (r[b] == r[a] && b < a)) ? 1u : 0u;
+                    rank += (r[b] < r[a] || (r[b] == r[a] && b < a)) ? 1 : 0;
                 }
-                med += rank == m ? r[a] : 0u;
+                med += rank == m ? r[a] : 0;
             }
-            median[p] = med;
-            valid[p] = k;
+            median[p] = static_cast<std::uint32_t>(med);
+            valid[p] = static_cast<std::uint32_t>(k);
+        }
+        // The agreement windows (a table lookup; a pixel without readings looks up the entry
+        // past the 16-bit range), then each pixel's agreeing readings, again without a branch.
+        for (std::size_t p = 0; p < len; ++p) tol[p] = pass.window[median[p]];
+        for (std::size_t p = 0; p < len; ++p) {
+            const auto med = static_cast<std::int32_t>(median[p]);
+            const auto window = static_cast<std::int32_t>(tol[p]);
+            std::int32_t sum = 0, kept = 0;
+            for (std::size_t f = 0; f < N; ++f) {
+                const std::int32_t v = pass.src[f][start + p];
+                const std::int32_t d = v > med ? v - med : med - v;
+                const bool agrees = v != 0 && d <= window;
+                sum += agrees ? v : 0;
+                kept += agrees ? 1 : 0;
+            }
+            sums[p] = static_cast<std::uint32_t>(sum);
+            agreeing[p] = static_cast<std::uint32_t>(kept);
         }
         for (std::size_t p = 0; p < len; ++p) {
-            if (valid[p] < pass.required) continue;
-            const std::uint32_t med = median[p];
-            const std::uint32_t tol = pass.window[med];
-            std::uint32_t sum = 0, kept = 0;
-            for (std::size_t f = 0; f < N; ++f) {
-                const std::uint32_t v = pass.src[f][start + p];
-                const std::uint32_t d = v > med ? v - med : med - v;
-                const bool agrees = v != 0 && d <= tol;
-                sum += agrees ? v : 0u;
-                kept += agrees ? 1u : 0u;
-            }
-            // No strict majority agrees: the pixel is unstable (an edge or a moving surface).
-            if (kept < pass.required || 2 * kept <= valid[p]) continue;
-            out->z_m[start + p] =
-                static_cast<float>(static_cast<double>(sum) * pass.unit / static_cast<double>(kept));
+            // Too few readings, too few agreeing, or no strict majority (the pixel is unstable:
+            // an edge or a moving surface).
+            const std::uint32_t kept = agreeing[p];
+            if (valid[p] < pass.required || kept < pass.required || 2 * kept <= valid[p]) continue;
+            out->z_m[start + p] = static_cast<float>(static_cast<double>(sums[p]) * pass.unit /
+                                                     static_cast<double>(kept));
         }
     }
 }
@@ -142,7 +151,7 @@ Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, doubl
     for (const DepthImage& f : frames) pass.src.push_back(f.pixels.data());
     // The agreement window of SPEC section 7's sensor model grows with depth: looked up per raw
     // median reading (in raw units) instead of computed in metres for every pixel.
-    pass.window.resize(65536);
+    pass.window.resize(65537);  // the last entry: a pixel without readings (never used)
     for (std::size_t v = 0; v < pass.window.size(); ++v) {
         const double z = static_cast<double>(v) * depth_unit_m;
         const double tol = config.agreement_abs_m + config.agreement_rel_per_m * z * z;
