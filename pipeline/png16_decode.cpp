@@ -64,10 +64,12 @@ bool Unfilter(std::uint8_t type, std::uint8_t* row, const std::uint8_t* prior, s
         case 0:
             return true;
         case 1:
-            for (std::size_t i = bpp; i < n; ++i) row[i] = static_cast<std::uint8_t>(row[i] + row[i - bpp]);
+            for (std::size_t i = bpp; i < n; ++i)
+                row[i] = static_cast<std::uint8_t>(row[i] + row[i - bpp]);
             return true;
         case 2:
-            for (std::size_t i = 0; i < n; ++i) row[i] = static_cast<std::uint8_t>(row[i] + prior[i]);
+            for (std::size_t i = 0; i < n; ++i)
+                row[i] = static_cast<std::uint8_t>(row[i] + prior[i]);
             return true;
         case 3:
             for (std::size_t i = 0; i < n; ++i) {

@@ -11,11 +11,11 @@
 namespace boxd {
 
 enum class Png16Decode {
-    kDecoded,     // *out holds the image
-    kOtherForm,   // a PNG this path does not read (interlaced, other chunks): ask libpng
-    kBroken,      // not a PNG, or a damaged one (bad signature, CRC, chunk layout or data)
-    kWrongKind,   // a PNG, but not 16-bit greyscale
-    kWrongSize,   // a 16-bit greyscale PNG of another size: *header_w x *header_h
+    kDecoded,    // *out holds the image
+    kOtherForm,  // a PNG this path does not read (interlaced, other chunks): ask libpng
+    kBroken,     // not a PNG, or a damaged one (bad signature, CRC, chunk layout or data)
+    kWrongKind,  // a PNG, but not 16-bit greyscale
+    kWrongSize,  // a 16-bit greyscale PNG of another size: *header_w x *header_h
 };
 
 // Decodes the PNG file held in `data` (`size` bytes), which must be `width` x `height`. The

@@ -21,7 +21,6 @@ struct Support {
     double se_forward = 0.0, se_backward = 0.0;
 };
 
-// The support along (cos φ, sin φ) read from cells of `cell_along` x `cell_height`.
 // The outer layers in direction u (front) and -u (back), over cells of (across, up).
 struct Layers {
     CellGrid<LayerCell> front, back;

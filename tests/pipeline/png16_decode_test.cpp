@@ -42,15 +42,15 @@ void WriteWithLibpng(const std::filesystem::path& path, const DepthImage& img, i
     png_init_io(png, f);
     png_set_filter(png, 0, filters);
     png_set_compression_buffer_size(png, idat_bytes);
-    png_set_IHDR(png, info, static_cast<png_uint_32>(img.width), static_cast<png_uint_32>(img.height),
-                 16, PNG_COLOR_TYPE_GRAY, interlace, PNG_COMPRESSION_TYPE_DEFAULT,
-                 PNG_FILTER_TYPE_DEFAULT);
+    png_set_IHDR(png, info, static_cast<png_uint_32>(img.width),
+                 static_cast<png_uint_32>(img.height), 16, PNG_COLOR_TYPE_GRAY, interlace,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_write_info(png, info);
     png_set_swap(png);
     std::vector<png_bytep> rows(static_cast<std::size_t>(img.height));
     for (int y = 0; y < img.height; ++y) {
-        rows[static_cast<std::size_t>(y)] = reinterpret_cast<png_bytep>(
-            const_cast<std::uint16_t*>(img.pixels.data() + static_cast<std::size_t>(y) * img.width));
+        rows[static_cast<std::size_t>(y)] = reinterpret_cast<png_bytep>(const_cast<std::uint16_t*>(
+            img.pixels.data() + static_cast<std::size_t>(y) * img.width));
     }
     png_write_image(png, rows.data());
     png_write_end(png, nullptr);
@@ -113,8 +113,8 @@ TEST(DecodePng16, DamagedFilesAreBroken) {
         bad[i] ^= 0x10;
         EXPECT_EQ(Decode(bad, 16, 8, &out), Png16Decode::kBroken) << "byte " << i;
     }
-    for (std::size_t cut : {std::size_t{0}, std::size_t{8}, std::size_t{30}, good.size() - 12,
-                            good.size() - 1}) {
+    for (std::size_t cut :
+         {std::size_t{0}, std::size_t{8}, std::size_t{30}, good.size() - 12, good.size() - 1}) {
         const std::vector<std::uint8_t> part(good.begin(), good.begin() + static_cast<long>(cut));
         EXPECT_EQ(Decode(part, 16, 8, &out), Png16Decode::kBroken) << "cut at " << cut;
     }

@@ -52,8 +52,9 @@ TEST(NearestGridReference, KNearestFindsWhatPclsKdTreeFinds) {
                     // float rounding.
                     const float tol = 1e-6f * std::max(sqr[j], 1e-3f);
                     EXPECT_NEAR(found[j].sqr_dist, sqr[j], tol) << "k " << k << ", rank " << j;
-                    EXPECT_NEAR((points[static_cast<std::size_t>(found[j].index)] - q).squaredNorm(),
-                                found[j].sqr_dist, tol);
+                    EXPECT_NEAR(
+                        (points[static_cast<std::size_t>(found[j].index)] - q).squaredNorm(),
+                        found[j].sqr_dist, tol);
                 }
             }
         }
@@ -70,9 +71,9 @@ Points NoisyCornerWithStrays() {
     for (int i = 0; i < 24; ++i) {
         for (int j = 0; j < 24; ++j) {
             const float a = 0.0025f + 0.005f * i, b = 0.0025f + 0.005f * j;
-            pts.emplace_back(a, b, 0.12f + noise(rng));        // top
-            pts.emplace_back(0.12f + noise(rng), a, b);        // side x = 0.12
-            pts.emplace_back(a, 0.12f + noise(rng), b);        // side y = 0.12
+            pts.emplace_back(a, b, 0.12f + noise(rng));  // top
+            pts.emplace_back(0.12f + noise(rng), a, b);  // side x = 0.12
+            pts.emplace_back(a, 0.12f + noise(rng), b);  // side y = 0.12
         }
     }
     for (int i = 0; i < 25; ++i) pts.emplace_back(stray(rng), stray(rng), 0.2f + stray(rng));
@@ -96,7 +97,8 @@ TEST(BuildRegistrationCloudReference, OutliersAndNormalsAsPclFindsThem) {
     pcl::PointCloud<pcl::Normal> normals;
     pcl::NormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
     ne.setInputCloud(kept);
-    ne.setSearchMethod(pcl::search::KdTree<pcl::PointXYZ>::Ptr(new pcl::search::KdTree<pcl::PointXYZ>));
+    ne.setSearchMethod(
+        pcl::search::KdTree<pcl::PointXYZ>::Ptr(new pcl::search::KdTree<pcl::PointXYZ>));
     ne.setKSearch(config.normal_neighbors);
     ne.compute(normals);
     Points ref_points, ref_normals;
@@ -109,7 +111,7 @@ TEST(BuildRegistrationCloudReference, OutliersAndNormalsAsPclFindsThem) {
         ref_points.push_back(p);
         ref_normals.push_back(normal);
     }
-    ASSERT_LT(kept->size(), points.size());  // some strays are removed ...
+    ASSERT_LT(kept->size(), points.size());      // some strays are removed ...
     ASSERT_LT(ref_points.size(), kept->size());  // ... and the edges' points dropped
     ASSERT_EQ(ours.points.size(), ref_points.size());
     for (std::size_t i = 0; i < ref_points.size(); ++i) {
