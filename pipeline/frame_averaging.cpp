@@ -180,18 +180,10 @@ Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, doubl
 
 namespace {
 
-// Whether the reading z at column x of `row` jumps from a valid neighbour among the columns
-// x0..x1 of the rows `rows` by more than tol (the pixel itself never differs from itself).
-bool Jumps(const std::array<const float*, 3>& rows, int nrows, int x0, int x1, float z,
-           float tol) {
-    bool jumps = false;
-    for (int r = 0; r < nrows; ++r) {
-        for (int xx = x0; xx <= x1; ++xx) {
-            const float zn = rows[static_cast<std::size_t>(r)][xx];
-            jumps |= zn > 0.0f && std::abs(zn - z) > tol;
-        }
-    }
-    return jumps;
+// 1 when the neighbour reading zn is valid and jumps from z by more than tol, else 0. Bitwise,
+// not short-circuit: the loop that ors these has no branch and vectorises.
+inline int Jump(float zn, float z, float tol) {
+    return static_cast<int>(zn > 0.0f) & static_cast<int>(std::abs(zn - z) > tol);
 }
 
 }  // namespace
@@ -213,33 +205,38 @@ DepthMap RemoveFlyingPixels(const DepthMap& depth, const FlyingPixelConfig& conf
             }
             const float* row = cur.z_m.data() + static_cast<std::size_t>(y) * w;
             float* out = next.z_m.data() + static_cast<std::size_t>(y) * w;
-            // Inside the image, nothing branches on the readings (the loop vectorises); the
-            // first and last columns take the bounded path.
-            if (nrows == 3 && w > 2) {
-                const float* up = rows[0];
-                const float* down = rows[2];
-                for (int x = 1; x < w - 1; ++x) {
-                    const float z = row[x];
-                    const float tol = abs_m + rel * z;
-                    // Bitwise, not short-circuit: no branch in the loop.
-                    auto jump = [z, tol](float zn) {
-                        return static_cast<int>(zn > 0.0f) & static_cast<int>(std::abs(zn - z) > tol);
-                    };
-                    const int jumps = jump(up[x - 1]) | jump(up[x]) | jump(up[x + 1]) |
-                                      jump(row[x - 1]) | jump(row[x + 1]) | jump(down[x - 1]) |
-                                      jump(down[x]) | jump(down[x + 1]);
-                    out[x] = (static_cast<int>(z > 0.0f) & jumps) != 0 ? 0.0f : z;
-                }
-            }
-            for (int x = 0; x < w; ++x) {
-                if (nrows == 3 && x > 0 && x < w - 1) x = w - 1;
+            // Pixel x against its neighbours in the rows and columns the image has (the pixel
+            // itself never differs from itself).
+            auto bounded = [&](int x) {
                 const float z = row[x];
-                if (z <= 0.0f) continue;
-                if (Jumps(rows, nrows, std::max(0, x - 1), std::min(w - 1, x + 1), z,
-                          abs_m + rel * z)) {
-                    out[x] = 0.0f;
+                const float tol = abs_m + rel * z;
+                int jumps = 0;
+                for (int r = 0; r < nrows; ++r) {
+                    for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx) {
+                        jumps |= Jump(rows[static_cast<std::size_t>(r)][xx], z, tol);
+                    }
                 }
+                if (z > 0.0f && jumps != 0) out[x] = 0.0f;
+            };
+            if (nrows < 3 || w <= 2) {
+                for (int x = 0; x < w; ++x) bounded(x);
+                continue;
             }
+            // Inside the image all eight neighbours exist: no bound to check, no branch on the
+            // readings, and the loop vectorises. The first and last columns are bounded.
+            const float* up = rows[0];
+            const float* down = rows[2];
+            for (int x = 1; x < w - 1; ++x) {
+                const float z = row[x];
+                const float tol = abs_m + rel * z;
+                const int jumps = Jump(up[x - 1], z, tol) | Jump(up[x], z, tol) |
+                                  Jump(up[x + 1], z, tol) | Jump(row[x - 1], z, tol) |
+                                  Jump(row[x + 1], z, tol) | Jump(down[x - 1], z, tol) |
+                                  Jump(down[x], z, tol) | Jump(down[x + 1], z, tol);
+                out[x] = (static_cast<int>(z > 0.0f) & jumps) != 0 ? 0.0f : z;
+            }
+            bounded(0);
+            bounded(w - 1);
         }
         cur = std::move(next);
     }

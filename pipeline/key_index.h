@@ -12,7 +12,8 @@ namespace boxd {
 
 class KeyIndex {
 public:
-    // Returns the index of `key`, adding it as the next index (size() before the call) when new.
+    // Returns the index of `key`, adding it as the next index (the count of keys so far) when
+    // it is new.
     std::size_t Find(std::uint64_t key) {
         if (2 * (count_ + 1) > slots_.size()) Grow();
         std::size_t h = Home(key);
@@ -23,9 +24,6 @@ public:
         slots_[h] = {key, static_cast<std::int64_t>(count_)};
         return count_++;
     }
-
-    // The number of distinct keys found so far.
-    std::size_t size() const { return count_; }
 
 private:
     struct Slot {

@@ -3,10 +3,9 @@
 #include <png.h>
 
 #include <algorithm>
-#include <cstdint>
-
 #include <bit>
 #include <csetjmp>
+#include <cstdint>
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -104,10 +103,6 @@ const char* WriteFrom(std::FILE* f, const DepthImage& image, int compression,
     png_destroy_write_struct(&png, &info);
     return nullptr;
 }
-
-}  // namespace
-
-namespace {
 
 Error WrongSize(std::uint32_t header_w, std::uint32_t header_h, int width, int height) {
     return Error{ErrorCode::kInvalidInput,

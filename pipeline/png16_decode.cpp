@@ -128,11 +128,11 @@ Png16Decode DecodePng16(const std::uint8_t* data, std::size_t size, int width, i
     while (!ended) {
         if (!NextChunk(data, size, &pos, &chunk)) return Png16Decode::kBroken;
         if (chunk.type == Tag("IDAT")) {
-            if (idat != nullptr && joined.empty()) joined.assign(idat, idat + idat_size);
             if (idat == nullptr) {
                 idat = chunk.data;
                 idat_size = chunk.length;
             } else {
+                if (joined.empty()) joined.assign(idat, idat + idat_size);
                 joined.insert(joined.end(), chunk.data, chunk.data + chunk.length);
             }
         } else if (chunk.type == Tag("IEND")) {
