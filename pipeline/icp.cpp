@@ -47,6 +47,7 @@ struct Linearization {
     int matched = 0;
     int solved = 0;
     double weight_sum = 0.0;
+    double height_sum = 0.0;  // weighted heights of the upright correspondences
     Eigen::Matrix3d p2p_jtj = Eigen::Matrix3d::Zero();  // point-to-point part, solve only
     Eigen::Vector3d p2p_jtr = Eigen::Vector3d::Zero();
 };
@@ -91,6 +92,7 @@ Linearization Linearize(const OrientedPoints& source, const IcpTarget& target, c
         lin.jtj += w * jac * jac.transpose();
         lin.jtr += w * jac * r;
         lin.weight_sum += w;
+        lin.height_sum += w * pt.z();
         ++lin.solved;
     }
     return lin;
@@ -137,7 +139,10 @@ IcpResult AlignIcp(const OrientedPoints& source, const IcpTarget& target, const 
     result.rmse = fin.matched > 0 ? std::sqrt(fin.sq_sum / fin.matched) : 0.0;
     const double sigma = std::max(result.rmse, config.sigma_floor_m);
     result.information = fin.jtj / (sigma * sigma);
-    if (fin.weight_sum > 0.0) result.point_scatter = fin.jtj / fin.weight_sum;
+    if (fin.weight_sum > 0.0) {
+        result.point_scatter = fin.jtj / fin.weight_sum;
+        result.mean_height_m = fin.height_sum / fin.weight_sum;
+    }
     if (fin.solved < config.min_correspondences) result.converged = false;
     return result;
 }

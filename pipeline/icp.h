@@ -54,6 +54,9 @@ struct IcpResult {
     // min_correspondences the alignment never moved and `transform` is its start.
     int solved = 0;
     int iterations = 0;
+    // The weighted mean height of the upright correspondences: the height at which the in-plane
+    // motion fits the data (see ReframedAlignment, view_registration.h).
+    double mean_height_m = 0.0;
 };
 
 // A target cloud with its search grid, built once and shared by every alignment onto it. The

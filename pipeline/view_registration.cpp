@@ -128,6 +128,22 @@ PairAlignment AlignViewPair(int i, int j, const ViewClouds& view_j, const ViewTa
     return out;
 }
 
+PairAlignment ReframedAlignment(PairAlignment alignment, const Eigen::Isometry3d& move) {
+    const Se2& x = alignment.edge.measured;
+    Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+    motion.linear() = Eigen::AngleAxisd(x.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    motion.translation() = Eigen::Vector3d(x.x, x.y, 0.0);
+    const Eigen::Isometry3d moved = move * motion * move.inverse();
+    // The in-plane motion that agrees with `moved` at the alignment's height: a point on the
+    // axis there goes where `moved` takes it.
+    const Eigen::Vector3d on_axis = moved * Eigen::Vector3d(0.0, 0.0, alignment.fine.mean_height_m);
+    const Se2 reframed{on_axis.x(), on_axis.y(),
+                       std::atan2(moved.linear()(1, 0), moved.linear()(0, 0))};
+    alignment.edge.measured = reframed;
+    alignment.fine.transform = reframed;
+    return alignment;
+}
+
 std::vector<PoseEdge> AcceptedEdges(const std::vector<PairAlignment>& alignments,
                                     const RegistrationConfig& config, EdgeStats* stats) {
     std::vector<PoseEdge> accepted;

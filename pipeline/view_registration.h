@@ -2,6 +2,7 @@
 // Stages 3 and 4: initial poses from the turntable angles and the ICP edges of the pose graph
 // (neighbouring poses and loop closures between non-neighbours, last-to-first included).
 
+#include <Eigen/Geometry>
 #include <utility>
 #include <vector>
 
@@ -97,6 +98,19 @@ struct PairAlignment {
 };
 PairAlignment AlignViewPair(int i, int j, const ViewClouds& view_j, const ViewTargets& target_i,
                             const std::vector<Se2>& model, const RegistrationConfig& config);
+
+// Returns `alignment` as it reads in a table frame moved by `move` (from the frame it was made
+// in): a capture aligns its views in the frame of the first pose's table top and fuses them in
+// the plane refitted to every pose (view_stream.h). An in-plane motion is a turn about the frame's
+// z axis; the turn of the table is about its true axis. Where the two axes differ by a tilt ε,
+// the best in-plane motion turns about the point where the true axis crosses the height of the
+// aligned surfaces, h ε to the side of the frame's axis, and carried over as it stands into a
+// frame whose z axis is the true one, it would turn each view about the wrong centre: every view
+// shifts along the same direction of the camera, each face outwards, and the box grows by about
+// 2 h ε (0.3 mm per tenth of a degree at 20 cm). So the motion is moved as a rigid motion,
+// move ∘ X ∘ move⁻¹, and read back in the plane at the alignment's own mean height
+// (IcpResult::mean_height_m), where it held.
+PairAlignment ReframedAlignment(PairAlignment alignment, const Eigen::Isometry3d& move);
 
 // Returns the edges of the alignments that hold (enough matched points, small RMSE), in the
 // order given, and their statistics in `stats` (when given).

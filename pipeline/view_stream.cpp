@@ -229,8 +229,8 @@ std::optional<MeasurementReason> ViewStream::Complete() {
             table_error_ = all.error();
         } else {
             table_ = *all;
-            const Eigen::Isometry3f move =
-                (table_.camera_to_table * provisional_->camera_to_table.inverse()).cast<float>();
+            move_ = table_.camera_to_table * provisional_->camera_to_table.inverse();
+            const Eigen::Isometry3f move = move_.cast<float>();
             spdlog::debug("table: refitted to every pose, the views move by {:.3f} mm and {:.4f} deg",
                           move.translation().norm() * 1e3,
                           Eigen::AngleAxisf(move.linear()).angle() * 180.0 / M_PI);
@@ -251,7 +251,10 @@ std::optional<MeasurementReason> ViewStream::Complete() {
 }
 
 std::vector<PoseEdge> ViewStream::Edges(EdgeStats* stats) const {
-    std::vector<PairAlignment> sorted = alignments_;
+    // The alignments were made in the provisional frame; the views are fused in the refitted one.
+    std::vector<PairAlignment> sorted;
+    sorted.reserve(alignments_.size());
+    for (const PairAlignment& a : alignments_) sorted.push_back(ReframedAlignment(a, move_));
     std::sort(sorted.begin(), sorted.end(), [](const PairAlignment& a, const PairAlignment& b) {
         return std::pair(a.edge.from, a.edge.to) < std::pair(b.edge.from, b.edge.to);
     });

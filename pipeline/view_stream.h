@@ -100,6 +100,8 @@ private:
     std::vector<std::vector<Eigen::Vector3d>> candidates_;  // per pose, subsampled
     std::optional<TablePlaneFit> provisional_;
     TablePlaneFit table_;
+    // From the provisional table frame the alignments were made in to the refitted one.
+    Eigen::Isometry3d move_ = Eigen::Isometry3d::Identity();
     std::vector<DepthMap> pending_;  // accepted depths not yet cut into views, from `segmented_`
     int segmented_ = 0;
     bool completed_ = false;
