@@ -22,11 +22,21 @@ struct RegistrationConfig {
                      .translation_tolerance_m = 1e-4,
                      .yaw_tolerance_rad = 1e-4,
                      .robust_scale_m = 0.008};
+    // The fine stage is point-to-plane only. A point-to-point pull to the nearest sample of a
+    // sampled surface has no restoring force along that surface (the offsets to the nearest
+    // samples spread over the sampling cell however far the views have slid), so where the
+    // surfaces constrain a direction only weakly it holds the motion where it started: at the
+    // turntable model, whose centre is the calibration's, millimetres off. Every edge then
+    // leans the same way, the views turn about a centre pulled towards the calibrated one, and
+    // the box grows or shrinks by a few tenths of a millimetre on every side. The coarse stage
+    // keeps the pull: it is what holds a direction no surface fixes (a standing tube's turn)
+    // near the model, and the fine stage's weak prior keeps it there.
     IcpConfig fine{.max_correspondence_m = 0.008,
                    .max_iterations = 10,
                    .translation_tolerance_m = 5e-5,
                    .yaw_tolerance_rad = 5e-5,
-                   .robust_scale_m = 0.003};
+                   .robust_scale_m = 0.003,
+                   .point_to_point_weight = 0.0};
     int max_pose_step = 3;  // pairs up to this many poses apart (cyclically) are aligned ...
     double max_pair_angle_deg = 100.0;  // ... when their turntable angles differ by at most this
     double min_fitness = 0.3;           // an alignment with fewer matched points is not an edge
