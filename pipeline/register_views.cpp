@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+
 namespace boxd {
 
 Result<RegisteredViews> RegisterViews(const std::vector<RegistrationClouds>& clouds,
@@ -32,6 +34,16 @@ Result<RegisteredViews> SolveViewGraph(std::vector<PoseEdge> edges, const EdgeSt
                      report->rejected_edges, report->rejected_edges + report->active_edges);
     }
     out.pose_covariance = PoseCovariance(graph, pose_graph);
+    // The edges align shared clouds: each view's cloud enters every edge of that view, and
+    // however its noise makes it seem to sit, all of those edges say alike. The graph puts the
+    // view's pose exactly there and its residuals never show it, while the covariance counts
+    // the view's data once per edge. A view is known only as well as its own cloud places it:
+    // the covariance widens by the edges per view (half the mean degree), no less than 1.
+    if (!graph.poses.empty()) {
+        const double shared =
+            static_cast<double>(report->active_edges) / static_cast<double>(graph.poses.size());
+        out.pose_covariance *= std::max(1.0, shared);
+    }
     out.poses = std::move(graph.poses);
     out.graph = *report;
     return out;

@@ -1,0 +1,128 @@
+#!/usr/bin/env python3
+"""Ideal boxes on stations nobody chose: renders COUNT boxes of random size (0.12-0.6 m long,
+0.06-0.5 m tall), on random stations (camera 0.8-1.15 m away, 30-50 degrees up, aimed at 30-60%
+of the box's height), with either noise model or none, 1-6 frames, 8-36 poses, the box up to
+5 cm off the axis at any yaw, and the synthetic station's default turntable angle and
+calibration errors, then measures each with `boxd measure`. The draws come from SEED only, so a
+sweep is repeatable; the accuracy suite (tests/accuracy/cases.json) is chosen by hand, this is
+not.
+
+Prints each case (errors and 95% bounds in mm, or the refusal) and a summary: the worst and RMS
+error per dimension, how many footprint errors exceed 1 mm, how many dimensions lie within
+their reported bound, and the median bound against the median error.
+
+Usage: scripts/accuracy_sweep.py [--boxd build/daemon/boxd] [--seed 1] [--count 60] [--jobs 2]
+Exit status 1 when a measured box is off by more than --fail-above-mm (default 1.0) in any
+dimension, or no case could be measured.
+"""
+import argparse
+import concurrent.futures
+import json
+import math
+import os
+import random
+import statistics
+import subprocess
+import sys
+import tempfile
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+KEYS = ("length_m", "width_m", "height_m")
+DISC_RADIUS_M = 0.4  # the synthetic turntable's disc
+
+
+def draw_case(rng, index, seed):
+    """One station and box, drawn so that the box stands on the disc."""
+    while True:
+        length = rng.uniform(0.12, 0.6)
+        width = rng.uniform(0.1, length)
+        height = rng.uniform(0.06, 0.5)
+        offset = (rng.uniform(-0.05, 0.05), rng.uniform(-0.05, 0.05))
+        reach = math.hypot(length, width) / 2 + math.hypot(*offset)
+        if reach < DISC_RADIUS_M - 0.01:
+            break
+    return {
+        "name": f"s{seed}_{index}",
+        "args": ["--dims", f"{length:.3f}", f"{width:.3f}", f"{height:.3f}",
+                 "--noise", rng.choice(["kinect", "kinect", "realsense", "none"]),
+                 "--poses", str(rng.choice([8, 12, 18, 18, 24, 36])),
+                 "--frames", str(rng.choice([1, 2, 3, 4, 6])),
+                 "--seed", str(1000 * seed + index),
+                 "--distance", f"{rng.uniform(0.8, 1.15):.2f}",
+                 "--elevation", f"{rng.uniform(30, 50):.0f}",
+                 "--aim-height", f"{height * rng.uniform(0.3, 0.6):.3f}",
+                 "--offset", f"{offset[0]:.3f}", f"{offset[1]:.3f}",
+                 "--yaw", f"{rng.uniform(-45, 45):.0f}"],
+    }
+
+
+def run_case(boxd, case):
+    with tempfile.TemporaryDirectory() as tmp:
+        session = os.path.join(tmp, "session")
+        synth = subprocess.run([boxd, "synth", "--out", session, *case["args"]],
+                               capture_output=True, text=True)
+        if synth.returncode != 0:
+            return {**case, "status": "synth failed", "reason": synth.stderr.strip()}
+        measured = subprocess.run([boxd, "measure", "--session", session],
+                                  capture_output=True, text=True)
+        try:
+            result = json.loads(measured.stdout)
+        except json.JSONDecodeError:
+            return {**case, "status": f"exit {measured.returncode}",
+                    "reason": measured.stderr.strip()}
+        with open(os.path.join(session, "session.json"), encoding="utf-8") as f:
+            truth = json.load(f)["ground_truth"]
+    out = {**case, "status": result["status"]}
+    if result["status"] != "ok":
+        out["reason"] = (result.get("reason") or {}).get("code", "")
+        return out
+    out["error_mm"] = [1000 * (result["dimensions"][k] - truth[k]) for k in KEYS]
+    out["bound_mm"] = [1000 * result["uncertainty_m"][k] for k in KEYS]
+    out["shape"] = result["shape"]
+    return out
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--boxd", default=os.path.join(HERE, "..", "build", "daemon", "boxd"))
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--count", type=int, default=60)
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--fail-above-mm", type=float, default=1.0)
+    args = parser.parse_args()
+    rng = random.Random(args.seed)
+    cases = [draw_case(rng, i, args.seed) for i in range(args.count)]
+    with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
+        outcomes = list(pool.map(lambda c: run_case(args.boxd, c), cases))
+
+    measured = [o for o in outcomes if "error_mm" in o]
+    for o in outcomes:
+        if "error_mm" in o:
+            cells = " ".join(f"{e:+6.2f} ({b:4.2f})" for e, b in zip(o["error_mm"], o["bound_mm"]))
+            print(f"{o['name']:10s} {cells}  {o['shape']:9s} {' '.join(o['args'])}")
+        else:
+            print(f"{o['name']:10s} {o['status']} {o.get('reason', '')}  {' '.join(o['args'])}")
+    if not measured:
+        print("no case was measured")
+        return 1
+    print(f"\n{len(measured)} of {len(outcomes)} measured; refused: "
+          + (", ".join(sorted(o.get("reason", o["status"]) for o in outcomes
+                              if "error_mm" not in o)) or "none"))
+    for k, name in enumerate(("length", "width", "height")):
+        errors = [abs(o["error_mm"][k]) for o in measured]
+        rms = math.sqrt(sum(e * e for e in errors) / len(errors))
+        print(f"{name:6s}: worst |error| {max(errors):.2f} mm, RMS {rms:.2f} mm")
+    footprint = [abs(o["error_mm"][k]) for o in measured for k in (0, 1)]
+    print(f"footprint errors above 1 mm: {sum(e > 1.0 for e in footprint)} of {len(footprint)}")
+    pairs = [(abs(o["error_mm"][k]), o["bound_mm"][k]) for o in measured for k in range(3)]
+    within = sum(e <= b for e, b in pairs)
+    print(f"true error within the reported 95% bound: {within} of {len(pairs)} dimensions "
+          f"({100.0 * within / len(pairs):.0f}%)")
+    print(f"median bound {statistics.median(b for _, b in pairs):.2f} mm, "
+          f"median |error| {statistics.median(e for e, _ in pairs):.2f} mm")
+    worst = max(e for e, _ in pairs)
+    return 1 if worst > args.fail_above_mm else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
