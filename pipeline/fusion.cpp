@@ -60,6 +60,7 @@ FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& p
         out.points.push_back(all.points[i]);
         out.view.push_back(all.view[i]);
     }
+    out.unfiltered = std::move(all.points);
     return out;
 }
 

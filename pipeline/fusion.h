@@ -29,6 +29,12 @@ struct FusionConfig {
 struct FusedCloud {
     Points points;                    // table frame of pose 0
     std::vector<std::uint16_t> view;  // source view of each point
+    // Every point of the views, before the support test. The support test counts points per
+    // voxel, so where a face runs near a voxel boundary it keeps the readings on one side of it
+    // and drops the thinner layer on the other: a face fitted to the kept points moves by
+    // tenths of a millimetre (a top lies parallel to the grid: heights by up to 0.3 mm). The
+    // face fit trims its own outliers, so it reads these instead.
+    Points unfiltered;
 };
 
 struct ConsistencyReport {

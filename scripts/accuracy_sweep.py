@@ -116,8 +116,11 @@ def main():
     print(f"footprint errors above 1 mm: {sum(e > 1.0 for e in footprint)} of {len(footprint)}")
     pairs = [(abs(o["error_mm"][k]), o["bound_mm"][k]) for o in measured for k in range(3)]
     within = sum(e <= b for e, b in pairs)
+    per_dimension = ", ".join(
+        f"{name} {sum(abs(o['error_mm'][k]) <= o['bound_mm'][k] for o in measured)}"
+        for k, name in enumerate(("length", "width", "height")))
     print(f"true error within the reported 95% bound: {within} of {len(pairs)} dimensions "
-          f"({100.0 * within / len(pairs):.0f}%)")
+          f"({100.0 * within / len(pairs):.0f}%; {per_dimension} of {len(measured)})")
     print(f"median bound {statistics.median(b for _, b in pairs):.2f} mm, "
           f"median |error| {statistics.median(e for e, _ in pairs):.2f} mm")
     worst = max(e for e, _ in pairs)
