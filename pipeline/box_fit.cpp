@@ -266,13 +266,20 @@ Status BoxFitConfig::Validate() const {
 }
 
 Result<BoxFit> FitFootprintBox(const Points& points, const BoxFitConfig& config) {
-    if (points.size() < 10) return Error{ErrorCode::kObjectTooSmall, "too few object points"};
-    auto seeded = SeedFootprint(points, config);
+    return FitFootprintBox(points, points, config);
+}
+
+Result<BoxFit> FitFootprintBox(const Points& seed_points, const Points& points,
+                               const BoxFitConfig& config) {
+    if (seed_points.size() < 10 || points.size() < 10) {
+        return Error{ErrorCode::kObjectTooSmall, "too few object points"};
+    }
+    auto seeded = SeedFootprint(seed_points, config);
     if (!seeded) return seeded.error();
     BoxState s = *seeded;
     {
-        std::vector<float> z(points.size());
-        for (std::size_t i = 0; i < points.size(); ++i) z[i] = points[i].z();
+        std::vector<float> z(seed_points.size());
+        for (std::size_t i = 0; i < seed_points.size(); ++i) z[i] = seed_points[i].z();
         const auto q =
             static_cast<long>(config.seed_top_quantile * static_cast<double>(z.size() - 1));
         std::nth_element(z.begin(), z.begin() + q, z.end());

@@ -49,6 +49,12 @@ struct BoxFit {
 // OBJECT_TOO_SMALL / INSUFFICIENT_DATA errors when the cloud cannot support a box.
 Result<BoxFit> FitFootprintBox(const Points& points, const BoxFitConfig& config);
 
+// The same, seeded from `seed_points` (the minimal-area rectangle and the starting height) and
+// fitted to `points`: the seed takes extremes and wants a cloud without stray readings, while
+// the face fits trim their own outliers and want every reading of a face (fusion.h).
+Result<BoxFit> FitFootprintBox(const Points& seed_points, const Points& points,
+                               const BoxFitConfig& config);
+
 // Returns the PCA oriented bounding box of `points`: principal axes of the footprint in the table
 // plane plus the table normal (the object rests on the table), extents from the table top.
 OrientedBox FitPcaBox(const Points& points);

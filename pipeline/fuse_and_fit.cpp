@@ -9,7 +9,7 @@ FusedFit FuseAndFit(const std::vector<Points>& view_points, const std::vector<Se
     FusedFit out;
     out.fused = FuseViews(view_points, poses, fusion);
     if (laps) laps->Lap("fusion");
-    out.box = FitFootprintBox(out.fused.unfiltered, box_fit);
+    out.box = FitFootprintBox(out.fused.points, out.fused.unfiltered, box_fit);
     out.pca = FitPcaBox(out.fused.points);
     if (laps) laps->Lap("fit");
     if (!out.box) spdlog::debug("box fit: {}", out.box.error().message);

@@ -33,7 +33,8 @@ struct FusedCloud {
     // voxel, so where a face runs near a voxel boundary it keeps the readings on one side of it
     // and drops the thinner layer on the other: a face fitted to the kept points moves by
     // tenths of a millimetre (a top lies parallel to the grid: heights by up to 0.3 mm). The
-    // face fit trims its own outliers, so it reads these instead.
+    // face fits trim their own outliers, so they read these instead (their seed, which takes
+    // extremes, still reads `points`).
     Points unfiltered;
 };
 
