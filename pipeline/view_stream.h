@@ -11,7 +11,7 @@
 // the second pose arrives; a pose whose table is hidden waits for the next ones. Once every pose
 // is in, the plane is refitted to the table top of all of them, and the views' points move by
 // the small correction (tenths of a millimetre) before they are fused: heights are measured
-// from the plane every pose saw.
+// from the plane every pose saw. The alignments move with them (Edges, ReframedAlignment).
 
 #include <memory>
 #include <optional>
@@ -64,7 +64,8 @@ public:
     // frame (once), and returns the first refusal in the stages' order (an unusable pose, then
     // the table, then the views' checks).
     std::optional<MeasurementReason> Complete();
-    // After Complete: the table fit, the views, the accepted edges with their statistics.
+    // After Complete: the table fit, the views, the accepted edges (in the refitted frame) with
+    // their statistics.
     const TablePlaneFit& table() const { return table_; }
     ObjectViews& views() { return views_; }
     std::vector<PoseEdge> Edges(EdgeStats* stats) const;
