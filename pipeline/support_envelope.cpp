@@ -110,6 +110,35 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
     return out;
 }
 
+// A sloped patch of the top (an opened panel, a tube's shoulder) reaches its high end at its
+// uphill side, above its readings' mean: such a cell is read there (LargestBound). A patch is
+// sloped when its readings lie on a plane that rises by more than the noise and the surface
+// continues downhill: the neighbouring cell that way slopes the same way. A slope that ends at
+// its cell is a rim instead (a level top's edge with the wall below it sharing the cell), and
+// its high end is the level top's, which the mean already reads.
+void MarkSlopesToReadHigh(CellGrid<LayerCell>* grid, double sigma, const EnvelopeConfig& config) {
+    std::vector<LayerCell::Slope> slopes(grid->cells.size());
+    for (std::size_t k = 0; k < grid->cells.size(); ++k) {
+        if (grid->cells[k].n >= config.min_cell_points) slopes[k] = grid->cells[k].BestSlope(sigma);
+    }
+    for (int j = 0; j < grid->nb; ++j) {
+        for (int i = 0; i < grid->na; ++i) {
+            const std::size_t k = static_cast<std::size_t>(j) * grid->na + i;
+            if (!(slopes[k].rise > sigma)) continue;
+            const Eigen::Vector2d down = -slopes[k].gradient.normalized();
+            const int di = static_cast<int>(std::lround(std::sqrt(2.0) * down.x()));
+            const int dj = static_cast<int>(std::lround(std::sqrt(2.0) * down.y()));
+            const int ni = std::clamp(i + std::clamp(di, -1, 1), 0, grid->na - 1);
+            const int nj = std::clamp(j + std::clamp(dj, -1, 1), 0, grid->nb - 1);
+            const LayerCell::Slope& next = slopes[static_cast<std::size_t>(nj) * grid->na + ni];
+            if ((ni != i || nj != j) && next.rise > sigma &&
+                next.gradient.normalized().dot(-down) > 0.5) {
+                grid->cells[k].read_high_end = true;
+            }
+        }
+    }
+}
+
 }  // namespace
 
 double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double radius,
@@ -129,6 +158,7 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double ra
             if (p.z() >= max_z[k] - config.layer_sigmas * sigma) c->Add3(p.x(), p.y(), p.z());
         }
     }
+    MarkSlopesToReadHigh(&grid, sigma, config);
     int judged = 0;
     return LargestBound(grid.cells, config, sigma, cell, se, &judged);
 }

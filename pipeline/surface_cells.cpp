@@ -22,18 +22,35 @@ double LayerCell::Facing(double* off_plane) const {
     return std::abs(eig.eigenvectors().col(0).z());
 }
 
+LayerCell::Slope LayerCell::BestSlope(double noise_sigma) const {
+    const Eigen::Vector3d mean = sum3 / n;
+    const Eigen::Matrix3d cov = sum_outer / n - mean * mean.transpose();
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    const Eigen::Vector3d normal = eig.eigenvectors().col(0);
+    Slope out;
+    if (std::abs(normal.z()) < 1e-6) return out;
+    const Eigen::Vector2d g = -normal.head<2>() / normal.z();
+    const double rise_var = std::max(0.0, g.dot(cov.topLeftCorner<2, 2>() * g));
+    const double across_var = rise_var / std::max(g.squaredNorm(), 1e-12);
+    if (across_var < 4.0 * noise_sigma * noise_sigma) return out;
+    out.gradient = g;
+    out.rise = std::sqrt(rise_var);
+    return out;
+}
+
 double MedianOfLargest(int m) { return UpperNormalQuantile(1.0 - std::pow(0.5, 1.0 / m)); }
 
 double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
-                    double noise_sigma, double cell_extent_m, double* se, int* judged,
-                    bool walls) {
+                    double noise_sigma, double cell_extent_m, double* se, int* judged, bool walls) {
     // A cell's outer layer is one of three things; its own 3-D scatter says which.
     //  - A surface facing the direction (its normal within 60 degrees of it): the mean is the
     //    surface. Tilted by θ, it spreads over the cell's extent e by e·tan θ (at most the
     //    layer's depth), and its high end lies somewhere in that spread above the mean (a
     //    panel opened at 30 or 60 degrees): the uncertainty carries the spread's standard
-    //    deviation, spread / √12. (Reading the tilted patch's high end itself needs a finer
-    //    model than the cell: at any looser limit than 60 degrees, two faces meeting in a cell
+    //    deviation, spread / √12. A cell its caller marks `read_high_end` (a sloped patch of
+    //    the top that continues downhill, TopBound) is read at that high end instead: spread
+    //    evenly over the cell, its readings reach √3 standard deviations of their plane's rise
+    //    above their mean. (At any looser limit than 60 degrees, two faces meeting in a cell
     //    pass for one tilted surface and widen flat boxes by millimetres.)
     //  - One surface crossing the layer — a wall running along the direction, a steep panel,
     //    a tube's flank: its readings lie on one plane (their variance off
@@ -56,7 +73,11 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
         if (cos_t >= 0.5) {
             const double spread =
                 std::min(cell_extent_m * std::sqrt(1.0 - cos_t * cos_t) / cos_t, layer);
-            return {c.Mean(), spread > noise_sigma ? spread / std::sqrt(12.0) : 0.0};
+            const double se_spread = spread > noise_sigma ? spread / std::sqrt(12.0) : 0.0;
+            if (c.read_high_end) {
+                return {c.Mean() + std::sqrt(3.0) * c.BestSlope(noise_sigma).rise, se_spread};
+            }
+            return {c.Mean(), se_spread};
         }
         if (!walls || var - noise_var <= wander) return {c.Mean(), 0.0};
         if (off_plane > noise_var + wander) return {c.Mean(), layer / std::sqrt(12.0)};

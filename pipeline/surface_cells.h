@@ -51,6 +51,17 @@ struct LayerCell : CellStats {
     // in `off_plane` (when given) the variance of the readings about their best plane: the
     // noise for one surface, more for two (a corner's faces sharing the cell).
     double Facing(double* off_plane = nullptr) const;
+    // The readings' best plane as a slope s(a, b): its gradient, and how far it rises across
+    // the readings (the standard deviation of its values over their spread). No slope (zero)
+    // when that spread is within twice the noise: depth noise smears a wall's end along the
+    // viewing rays into a strip that narrow, and a plane through it is the rays', no surface's.
+    struct Slope {
+        Eigen::Vector2d gradient = Eigen::Vector2d::Zero();
+        double rise = 0.0;
+    };
+    Slope BestSlope(double noise_sigma) const;
+    // Set by the caller when the cell is a sloped patch to be read at its high end (TopBound).
+    bool read_high_end = false;
 };
 
 // Returns Φ⁻¹(0.5^(1/m)): the median of the largest of m standard normal draws.

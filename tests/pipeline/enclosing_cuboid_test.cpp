@@ -358,6 +358,30 @@ TEST(FitEnclosingCuboid, StepFillingItsFootprintIsIrregularByItsTop) {
     EXPECT_NEAR(c.height_m, 2.0 * h, 0.003);
 }
 
+TEST(FitEnclosingCuboid, PanelOpenedAtThirtyDegreesIsReadAtItsHighEnd) {
+    // A 0.4 x 0.3 x 0.2 carton whose top panel (half the length) is opened 30 degrees about the
+    // +x top edge: its outer face rises to the panel's free end, 0.1 m above the top. The top's
+    // 24 mm cells along that end hold a strip of the sloped face; their mean lies half the
+    // strip's rise (up to 3 mm) below the end, which the slope's reading recovers.
+    const double l = 0.40, w = 0.30, h = 0.20, open = 30.0 * M_PI / 180.0;
+    const Eigen::Vector3d up_slope(-std::cos(open), 0.0, std::sin(open));
+    const Eigen::Vector3d outward(std::sin(open), 0.0, std::cos(open));
+    CloudBuilder builder(0.3, {0.0, 0.0}, kSigma, 8);
+    FusedCloud box = SampleBlocks({{-l / 2, l / 2, -w / 2, w / 2, h}}, 0.0, 0.3, {0.0, 0.0}, 8);
+    builder.Patch(0.0, l / 2, -w / 2, w / 2, [&](double a, double b, auto& p, auto& n) {
+        p = Eigen::Vector3d(l / 2, b, h) + a * up_slope;
+        n = outward;
+        return true;
+    });
+    const FusedCloud panel = builder.cloud();
+    box.points.insert(box.points.end(), panel.points.begin(), panel.points.end());
+    box.view.insert(box.view.end(), panel.view.begin(), panel.view.end());
+    const Fitted f = Fit(box);
+    ASSERT_TRUE(f.cuboid.ok()) << f.cuboid.error().message;
+    EXPECT_FALSE(f.cuboid->cuboid);
+    EXPECT_NEAR(f.cuboid->height_m, h + l / 2 * std::sin(open), 0.0015);
+}
+
 TEST(FitEnclosingCuboid, LShapeIsIrregularAtTwoAndAHalfMillimetresOfNoise) {
     const double l = 0.40, w = 0.30, h = 0.20, sigma = 0.0025;
     const std::vector<Block> blocks = {{-l / 2, l / 2, -w / 2, 0.0, h},
