@@ -25,6 +25,9 @@ struct PoseGraphConfig {
     // along a face) do not count.
     double max_edge_displacement_m = 0.002;
     int max_rejection_rounds = 20;
+    // Rounds of re-solving with the edges and the prior weighed by their variance components
+    // (what their residuals show) instead of the sigmas above; 0 keeps the sigmas.
+    int variance_rounds = 2;
     int max_solver_iterations = 100;
 
     // Returns an error naming the first invalid field, or Ok.
@@ -63,7 +66,8 @@ struct PoseGraphReport {
 Status SolvePoseGraph(PoseGraph& graph, const PoseGraphConfig& config);
 
 // Solves, rejects the disagreeing edges that are the worst at their nodes, and re-solves until
-// every kept edge agrees or max_rejection_rounds rounds have rejected.
+// every kept edge agrees or max_rejection_rounds rounds have rejected; then re-solves with the
+// edges and the prior weighed by their variance components (variance_rounds).
 Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfig& config);
 
 // Returns the covariance of the solved poses, 3N x 3N in (x, y, yaw) per node (node 0 defines
