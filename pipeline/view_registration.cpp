@@ -119,6 +119,13 @@ PairAlignment AlignViewPair(int i, int j, const ViewClouds& view_j, const ViewTa
     PairAlignment out;
     out.fine = AlignIcp(view_j.fine, target_i.fine, coarse.transform, config.fine);
     out.coarse_iterations = coarse.iterations;
+    // Too few upright pairs on the fine cloud to move it (a small object in one noisy frame:
+    // its 6 mm cells' normals scatter past the pairing's agreement): the coarse alignment, on
+    // cells twice as large, is the measurement, and the edge carries its weaker information.
+    if (out.fine.solved < config.fine.min_correspondences &&
+        coarse.solved >= config.coarse.min_correspondences) {
+        out.fine = coarse;
+    }
     PoseEdge& edge = out.edge;
     edge.from = i;
     edge.to = j;

@@ -100,7 +100,8 @@ struct ViewTargets {
     IcpTarget coarse, fine;
 };
 
-// The alignment of view j into view i's frame (X_i⁻¹ ∘ X_j), coarse then fine from `model`.
+// The alignment of view j into view i's frame (X_i⁻¹ ∘ X_j), coarse then fine from `model`;
+// `fine` is the coarse result where the fine cloud had too few upright pairs to align.
 struct PairAlignment {
     PoseEdge edge;
     IcpResult fine;
