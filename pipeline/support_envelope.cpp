@@ -133,7 +133,7 @@ void MarkSlopesToReadHigh(CellGrid<LayerCell>* grid, double sigma, const Envelop
             const LayerCell::Slope& next = slopes[static_cast<std::size_t>(nj) * grid->na + ni];
             if ((ni != i || nj != j) && next.rise > sigma &&
                 next.gradient.normalized().dot(-down) > 0.5) {
-                grid->cells[k].read_high_end = true;
+                grid->cells[k].high_end_above_mean_m = std::sqrt(3.0) * slopes[k].rise;
             }
         }
     }

@@ -47,11 +47,11 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
     //    surface. Tilted by θ, it spreads over the cell's extent e by e·tan θ (at most the
     //    layer's depth), and its high end lies somewhere in that spread above the mean (a
     //    panel opened at 30 or 60 degrees): the uncertainty carries the spread's standard
-    //    deviation, spread / √12. A cell its caller marks `read_high_end` (a sloped patch of
-    //    the top that continues downhill, TopBound) is read at that high end instead: spread
-    //    evenly over the cell, its readings reach √3 standard deviations of their plane's rise
-    //    above their mean. (At any looser limit than 60 degrees, two faces meeting in a cell
-    //    pass for one tilted surface and widen flat boxes by millimetres.)
+    //    deviation, spread / √12. A cell its caller marks with `high_end_above_mean_m` (a
+    //    sloped patch of the top that continues downhill, TopBound) is read at that high end
+    //    instead: spread evenly over the cell, its readings reach √3 standard deviations of
+    //    their plane's rise above their mean. (At any looser limit than 60 degrees, two faces
+    //    meeting in a cell pass for one tilted surface and widen flat boxes by millimetres.)
     //  - One surface crossing the layer — a wall running along the direction, a steep panel,
     //    a tube's flank: its readings lie on one plane (their variance off
     //    it is the noise's) and spread evenly over the layer, so its high end lies √3 standard
@@ -74,10 +74,7 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
             const double spread =
                 std::min(cell_extent_m * std::sqrt(1.0 - cos_t * cos_t) / cos_t, layer);
             const double se_spread = spread > noise_sigma ? spread / std::sqrt(12.0) : 0.0;
-            if (c.read_high_end) {
-                return {c.Mean() + std::sqrt(3.0) * c.BestSlope(noise_sigma).rise, se_spread};
-            }
-            return {c.Mean(), se_spread};
+            return {c.Mean() + c.high_end_above_mean_m, se_spread};
         }
         if (!walls || var - noise_var <= wander) return {c.Mean(), 0.0};
         if (off_plane > noise_var + wander) return {c.Mean(), layer / std::sqrt(12.0)};

@@ -60,8 +60,9 @@ struct LayerCell : CellStats {
         double rise = 0.0;
     };
     Slope BestSlope(double noise_sigma) const;
-    // Set by the caller when the cell is a sloped patch to be read at its high end (TopBound).
-    bool read_high_end = false;
+    // Set by the caller where the cell is a sloped patch to be read at its high end (TopBound):
+    // how far above the readings' mean that end lies.
+    double high_end_above_mean_m = 0.0;
 };
 
 // Returns Φ⁻¹(0.5^(1/m)): the median of the largest of m standard normal draws.
