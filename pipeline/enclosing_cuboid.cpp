@@ -120,7 +120,7 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     if (box) {
         const BoxFit& fit = *box;
         const std::array<envelope::FaceResult, 5> faces =
-            envelope::FaceEnvelopes(cloud, fit, views, agreement_m, config);
+            envelope::FaceEnvelopes(cloud, fit, views, config);
         EnclosingCuboid c;
         for (std::size_t f = 0; f < 5; ++f) c.excess_m[f] = faces[f].excess_m;
         const Eigen::Vector2d a = fit.length_axis, b(-a.y(), a.x());

@@ -18,16 +18,26 @@ constexpr int kMinFlatnessCells = 10;
 // its sensor's disparity steps, so its points are not).
 struct FaceCells {
     int views = 1;
+    int na = 1;  // cells across the face's grid: a cell's key is row * na + column
     std::unordered_map<std::size_t, CellStats> cell_view;  // key cell * views + view
     std::vector<CellStats> view_plane;                     // per view: offsets near the plane
 
-    FaceResult Evaluate(const EnvelopeConfig& config, double point_sigma,
-                        double agreement_m) const {
+    // A cell judged for standing out: its mean over the views' means and its standard error.
+    struct Judged {
+        std::size_t key;
+        CellStats st;
+        double se;
+    };
+
+    FaceResult Evaluate(const EnvelopeConfig& config, double point_sigma) const {
         // Each cell's mean over its views' means, and the views' spread pooled over the face.
+        // The fused cloud keeps a pixel in nine, so a view holds a handful of readings in a
+        // cell, often one or two where it sees the face obliquely: every view that read the
+        // cell is a sample (the pooled spread is the spread of such samples), or a face's
+        // middle, where a bulge crests, would go unjudged.
         std::unordered_map<std::size_t, CellStats> cells;
-        for (const auto& [key, st] : cell_view) {
-            if (st.n >= 3) cells[key / static_cast<std::size_t>(views)].Add(st.Mean());
-        }
+        for (const auto& [key, st] : cell_view)
+            cells[key / static_cast<std::size_t>(views)].Add(st.Mean());
         double pooled = 0.0;
         int dof = 0, total = 0;
         for (const auto& [cell, st] : cells) {
@@ -40,14 +50,17 @@ struct FaceCells {
         // Without a second view of any cell (one pose), the within-view noise of a cell's mean,
         // its readings counted as a tenth as many independent ones.
         const double spread = dof >= 10 ? std::sqrt(pooled / dof) : point_sigma;
-        std::vector<CellStats> judged;
-        std::vector<double> se;
+        std::vector<Judged> judged;
         for (const auto& [cell, st] : cells) {
             if (st.n * 3 < config.min_cell_points && dof >= 10) continue;
-            judged.push_back(st);
-            se.push_back(dof >= 10
-                             ? spread / std::sqrt(st.n)
-                             : spread / std::sqrt(std::max(1.0, total / 10.0 / cells.size())));
+            // A cell whose views scatter more than the face's do (an edge some views see at
+            // grazing incidence, where the lateral noise throws readings off the face) is
+            // known no better than its own scatter says.
+            const double own = st.n >= 2 ? st.StdError() * std::sqrt(st.n) : 0.0;
+            judged.push_back(
+                {cell, st,
+                 dof >= 10 ? std::max(spread, own) / std::sqrt(st.n)
+                           : spread / std::sqrt(std::max(1.0, total / 10.0 / cells.size()))});
         }
         // The plane's offset as each view sees it: their spread is the registration's and the
         // noise's contribution to the face's position.
@@ -73,40 +86,67 @@ struct FaceCells {
         out.offset_se_m = offsets.n >= 2
                               ? offsets.StdError()
                               : spread / std::sqrt(std::max<std::size_t>(1, cells.size()));
-        // Views that disagree about where the face is (a miscalibrated station, an object that
-        // flexed) make cells stand out that are no surface of the object: a cell must also stand
-        // out beyond the views' spread about the plane.
-        const double threshold =
-            std::max(agreement_m, offsets.n >= 2 ? offsets.StdError() * std::sqrt(offsets.n) : 0.0);
-        // Detection: a cell counts as standing out when its lower bound passes the plane with
-        // the Bonferroni confidence over all the face's cells; the excess is then the largest
-        // mean among those cells, less the median of the largest of that many noise draws.
+        ReadExcess(judged, config, out.view_spread_m, &out);
+        return out;
+    }
+
+    // Detection: a cell stands out when its lower bound passes the plane, with the Bonferroni
+    // confidence over all the face's cells, by more than the views' spread about the plane
+    // (views that disagree about where the face is, on a miscalibrated station or a flexing
+    // object, make cells stand out that are no surface of the object), and a neighbouring cell
+    // stands out too: whatever stands out of a parcel's face (a bulge, a strap, a label) is
+    // wider than a cell, and a lone cell is a few views' artefact. The excess is read from the
+    // cells that could be the farthest out (within two standard errors of the farthest): the
+    // largest of their means, less the median of the largest of that many noise draws.
+    void ReadExcess(const std::vector<Judged>& judged, const EnvelopeConfig& config,
+                    double threshold, FaceResult* out) const {
         const int m = static_cast<int>(judged.size());
-        if (m > 0) {
-            const double k = UpperNormalQuantile(config.false_alarm / m);
-            int significant = 0;
-            auto stands_out = [&](int i) { return judged[i].Mean() - k * se[i] > threshold; };
-            for (int i = 0; i < m; ++i) significant += stands_out(i) ? 1 : 0;
-            if (significant > 0) {
-                const double z = MedianOfLargest(significant);
-                for (int i = 0; i < m; ++i) {
-                    if (!stands_out(i)) continue;
-                    const double excess = judged[i].Mean() - z * se[i];
-                    if (excess > out.excess_m) {
-                        out.excess_m = excess;
-                        out.excess_se_m = se[i];
+        if (m == 0) return;
+        const double k = UpperNormalQuantile(config.false_alarm / m);
+        std::unordered_map<std::size_t, int> alone;
+        for (const Judged& c : judged) {
+            if (c.st.Mean() - k * c.se > threshold) alone[c.key] = 1;
+        }
+        auto stands_out = [&](const Judged& c) {
+            if (alone.count(c.key) == 0) return false;
+            const long key = static_cast<long>(c.key), col = key % na;
+            for (long dj = -1; dj <= 1; ++dj) {
+                for (long di = -1; di <= 1; ++di) {
+                    const long other = key + dj * na + di;
+                    if ((di != 0 || dj != 0) && col + di >= 0 && col + di < na && other >= 0 &&
+                        alone.count(static_cast<std::size_t>(other)) != 0) {
+                        return true;
                     }
                 }
             }
+            return false;
+        };
+        const Judged* top = nullptr;
+        for (const Judged& c : judged) {
+            if (stands_out(c) && (top == nullptr || c.st.Mean() > top->st.Mean())) top = &c;
         }
-        return out;
+        if (top == nullptr) return;
+        auto competes = [&](const Judged& c) {
+            return stands_out(c) && c.st.Mean() >= top->st.Mean() - 2.0 * (c.se + top->se);
+        };
+        int contenders = 0;
+        for (const Judged& c : judged) contenders += competes(c) ? 1 : 0;
+        const double z = MedianOfLargest(contenders);
+        for (const Judged& c : judged) {
+            if (!competes(c)) continue;
+            const double excess = c.st.Mean() - z * c.se;
+            if (excess > out->excess_m) {
+                out->excess_m = excess;
+                out->excess_se_m = c.se;
+            }
+        }
     }
 };
 
 }  // namespace
 
 std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& box, int views,
-                                        double agreement_m, const EnvelopeConfig& config) {
+                                        const EnvelopeConfig& config) {
     const Eigen::Vector2d a = box.length_axis, b(-a.y(), a.x());
     const double hl = box.length_m / 2.0, hw = box.width_m / 2.0, h = box.height_m;
     const double m = config.edge_margin_m;
@@ -124,6 +164,7 @@ std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& b
         f.views = nv;
         f.view_plane.resize(static_cast<std::size_t>(nv));
     }
+    for (std::size_t f = 0; f < 5; ++f) faces[f].na = grids[f].na;
     for (std::size_t i = 0; i < cloud.points.size(); ++i) {
         const Eigen::Vector3f& p3 = cloud.points[i];
         const Eigen::Vector2d q = p3.head<2>().cast<double>() - box.center_m;
@@ -145,7 +186,7 @@ std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& b
     }
     std::array<FaceResult, 5> out;
     for (std::size_t f = 0; f < 5; ++f) {
-        out[f] = faces[f].Evaluate(config, std::max(box.face_sigma_m, 0.0005), agreement_m);
+        out[f] = faces[f].Evaluate(config, std::max(box.face_sigma_m, 0.0005));
     }
     return out;
 }

@@ -26,6 +26,6 @@ struct FaceResult {
 // The excess of the 4 side faces and the top of `box` over their fitted planes, and the
 // uncertainty of each plane from the spread of its offset between views.
 std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& box, int views,
-                                        double agreement_m, const EnvelopeConfig& config);
+                                        const EnvelopeConfig& config);
 
 }  // namespace boxd::envelope

@@ -21,6 +21,36 @@ struct Support {
     double se_forward = 0.0, se_backward = 0.0;
 };
 
+// A sloped patch of an outer layer (the top's: an opened panel, a tube's shoulder; a side's: the
+// panel's outer face leaning in from its hinge) reaches its high end at its uphill side, above
+// its readings' mean: such a cell is read there (LargestBound). A patch is
+// sloped when its readings lie on a plane that rises by more than the noise and the surface
+// continues downhill: the neighbouring cell that way slopes the same way. A slope that ends at
+// its cell is a rim instead (a level top's edge with the wall below it sharing the cell), and
+// its high end is the level top's, which the mean already reads.
+void MarkSlopesToReadHigh(CellGrid<LayerCell>* grid, double sigma, const EnvelopeConfig& config) {
+    std::vector<LayerCell::Slope> slopes(grid->cells.size());
+    for (std::size_t k = 0; k < grid->cells.size(); ++k) {
+        if (grid->cells[k].n >= config.min_cell_points) slopes[k] = grid->cells[k].BestSlope(sigma);
+    }
+    for (int j = 0; j < grid->nb; ++j) {
+        for (int i = 0; i < grid->na; ++i) {
+            const std::size_t k = static_cast<std::size_t>(j) * grid->na + i;
+            if (!(slopes[k].rise > sigma)) continue;
+            const Eigen::Vector2d down = -slopes[k].gradient.normalized();
+            const int di = static_cast<int>(std::lround(std::sqrt(2.0) * down.x()));
+            const int dj = static_cast<int>(std::lround(std::sqrt(2.0) * down.y()));
+            const int ni = std::clamp(i + std::clamp(di, -1, 1), 0, grid->na - 1);
+            const int nj = std::clamp(j + std::clamp(dj, -1, 1), 0, grid->nb - 1);
+            const LayerCell::Slope& next = slopes[static_cast<std::size_t>(nj) * grid->na + ni];
+            if ((ni != i || nj != j) && next.rise > sigma &&
+                next.gradient.normalized().dot(-down) > 0.5) {
+                grid->cells[k].high_end_above_mean_m = std::sqrt(3.0) * slopes[k].rise;
+            }
+        }
+    }
+}
+
 // The outer layers in direction u (front) and -u (back), over cells of (across, up).
 struct Layers {
     CellGrid<LayerCell> front, back;
@@ -82,12 +112,15 @@ void KeepGapsOnly(const CellGrid<LayerCell>& fine, CellGrid<LayerCell>& coarse,
 // times the readings, and fill those gaps only, as faces: where a small cell is judged its
 // reading stands, and a gap's larger cell is read at its mean (a larger cell's layer mixes more
 // surface, and on a noisy cloud would pass the ends of the faces that meet in it for walls
-// reaching millimetres farther).
+// reaching millimetres farther). A small cell where the surface slopes away inward, and goes on
+// sloping in the next cell (an opened panel rising from its hinge), is read at its outer end.
 Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double sigma,
                      double radius, double top, const EnvelopeConfig& config) {
     const Eigen::Vector2d u(std::cos(phi), std::sin(phi));
     const double along = config.cell_along_m, height = config.cell_height_m;
-    const Layers fine = BuildLayers(pts, u, sigma, radius, top, along, height, config);
+    Layers fine = BuildLayers(pts, u, sigma, radius, top, along, height, config);
+    MarkSlopesToReadHigh(&fine.front, sigma, config);
+    MarkSlopesToReadHigh(&fine.back, sigma, config);
     Layers coarse = BuildLayers(pts, u, sigma, radius, top, 2.0 * along, 2.0 * height, config);
     KeepGapsOnly(fine.front, coarse.front, config);
     KeepGapsOnly(fine.back, coarse.back, config);
@@ -108,35 +141,6 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
         farther(coarse, 2.0 * std::max(along, height), forward, false);
     }
     return out;
-}
-
-// A sloped patch of the top (an opened panel, a tube's shoulder) reaches its high end at its
-// uphill side, above its readings' mean: such a cell is read there (LargestBound). A patch is
-// sloped when its readings lie on a plane that rises by more than the noise and the surface
-// continues downhill: the neighbouring cell that way slopes the same way. A slope that ends at
-// its cell is a rim instead (a level top's edge with the wall below it sharing the cell), and
-// its high end is the level top's, which the mean already reads.
-void MarkSlopesToReadHigh(CellGrid<LayerCell>* grid, double sigma, const EnvelopeConfig& config) {
-    std::vector<LayerCell::Slope> slopes(grid->cells.size());
-    for (std::size_t k = 0; k < grid->cells.size(); ++k) {
-        if (grid->cells[k].n >= config.min_cell_points) slopes[k] = grid->cells[k].BestSlope(sigma);
-    }
-    for (int j = 0; j < grid->nb; ++j) {
-        for (int i = 0; i < grid->na; ++i) {
-            const std::size_t k = static_cast<std::size_t>(j) * grid->na + i;
-            if (!(slopes[k].rise > sigma)) continue;
-            const Eigen::Vector2d down = -slopes[k].gradient.normalized();
-            const int di = static_cast<int>(std::lround(std::sqrt(2.0) * down.x()));
-            const int dj = static_cast<int>(std::lround(std::sqrt(2.0) * down.y()));
-            const int ni = std::clamp(i + std::clamp(di, -1, 1), 0, grid->na - 1);
-            const int nj = std::clamp(j + std::clamp(dj, -1, 1), 0, grid->nb - 1);
-            const LayerCell::Slope& next = slopes[static_cast<std::size_t>(nj) * grid->na + ni];
-            if ((ni != i || nj != j) && next.rise > sigma &&
-                next.gradient.normalized().dot(-down) > 0.5) {
-                grid->cells[k].high_end_above_mean_m = std::sqrt(3.0) * slopes[k].rise;
-            }
-        }
-    }
 }
 
 }  // namespace

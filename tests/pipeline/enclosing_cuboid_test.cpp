@@ -273,8 +273,6 @@ TEST(FitEnclosingCuboid, BulgingLongSidesWidenTheBoxByTheBulge) {
 }
 
 TEST(FitEnclosingCuboid, BulgingLongSidesWidenTheBoxWithTheIcpRmseAsAgreement) {
-    GTEST_SKIP() << "limitation: a cell must clear the ICP RMSE (1.2-1.5 mm here, mostly noise), "
-                    "so a 4 mm bulge is found on 0-1 of 2 sides: width w + 4.2..7.0 mm, not w + 8";
     ExpectBulgeFound(-1.0);  // the views' ICP RMSE, as the measurement passes it
 }
 
