@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "pipeline/surface_cells.h"
 
@@ -51,13 +52,46 @@ void MarkSlopesToReadHigh(CellGrid<LayerCell>* grid, double sigma, const Envelop
     }
 }
 
+// The top of a smooth cap (a bag's crown, a lying tube's crest) lies above the mean of the cell
+// it crests in: on a quadratic surface z = z0 - (κx x² + κy y²) / 2 the mean over a square cell
+// of side c lies (κx + κy) c² / 24 below the top, and the cell means' discrete Laplacian (the
+// four neighbours' means less four times the cell's) is -(κx + κy) c². So a cell whose four
+// neighbours are judged is marked that far, a 24th of its negative Laplacian. A neighbour more
+// than the layer's depth away is another surface (an opened panel's tip over the box's top), not
+// the cap curving on, and the cell is left as it is.
+void MarkCapTops(CellGrid<LayerCell>* grid, double sigma, const EnvelopeConfig& config) {
+    auto at = [grid](int i, int j) -> const LayerCell* {
+        if (i < 0 || j < 0 || i >= grid->na || j >= grid->nb) return nullptr;
+        return &grid->cells[static_cast<std::size_t>(j) * grid->na + i];
+    };
+    const double layer = config.layer_sigmas * sigma;
+    std::vector<double> cap(grid->cells.size(), 0.0);
+    for (int j = 0; j < grid->nb; ++j) {
+        for (int i = 0; i < grid->na; ++i) {
+            const LayerCell& c = *at(i, j);
+            if (c.n < config.min_cell_points || c.high_end_above_mean_m > 0.0) continue;
+            double laplacian = 0.0;
+            bool smooth = true;
+            for (const auto& [di, dj] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+                const LayerCell* nb = at(i + di, j + dj);
+                smooth = smooth && nb != nullptr && nb->n >= config.min_cell_points &&
+                         std::abs(nb->Mean() - c.Mean()) <= layer;
+                if (smooth) laplacian += nb->Mean() - c.Mean();
+            }
+            if (smooth)
+                cap[static_cast<std::size_t>(j) * grid->na + i] = std::max(0.0, -laplacian / 24.0);
+        }
+    }
+    for (std::size_t k = 0; k < cap.size(); ++k) grid->cells[k].cap_above_mean_m = cap[k];
+}
+
 // The outer layers in direction u (front) and -u (back), over cells of (across, up).
 struct Layers {
     CellGrid<LayerCell> front, back;
 };
 
-Layers BuildLayers(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector2d& u,
-                   double sigma, double radius, double top, double cell_along, double cell_height,
+Layers BuildLayers(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector2d& u, double sigma,
+                   double radius, double top, double cell_along, double cell_height,
                    const EnvelopeConfig& config) {
     const Eigen::Vector2d v(-u.y(), u.x());
     Layers out{CellGrid<LayerCell>(-radius, radius, 0.0, top, cell_along, cell_height),
@@ -163,6 +197,7 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double ra
         }
     }
     MarkSlopesToReadHigh(&grid, sigma, config);
+    MarkCapTops(&grid, sigma, config);
     int judged = 0;
     return LargestBound(grid.cells, config, sigma, cell, se, &judged);
 }
@@ -177,7 +212,8 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma,
     // top or the other sides that reach out there. Such a direction bounds nothing.
     auto width = [&](double phi, Support* s) -> double {
         *s = SupportAlong(pts, phi, sigma, radius, top, config);
-        const Eigen::Vector2f u(static_cast<float>(std::cos(phi)), static_cast<float>(std::sin(phi)));
+        const Eigen::Vector2f u(static_cast<float>(std::cos(phi)),
+                                static_cast<float>(std::sin(phi)));
         double reach_f = -INFINITY, reach_b = -INFINITY;
         for (const Eigen::Vector3f& p : pts) {
             const double d = u.dot(p.head<2>());

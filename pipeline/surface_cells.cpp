@@ -50,7 +50,9 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
     //    deviation, spread / √12. A cell its caller marks with `high_end_above_mean_m` (a
     //    sloped patch of the top that continues downhill, TopBound) is read at that high end
     //    instead: spread evenly over the cell, its readings reach √3 standard deviations of
-    //    their plane's rise above their mean. (At any looser limit than 60 degrees, two faces
+    //    their plane's rise above their mean; one marked with `cap_above_mean_m` (the top of
+    //    a smooth cap) that far above its mean, uncertain by as much. (At any looser limit than
+    //    60 degrees, two faces
     //    meeting in a cell pass for one tilted surface and widen flat boxes by millimetres.)
     //  - One surface crossing the layer — a wall running along the direction, a steep panel,
     //    a tube's flank: its readings lie on one plane (their variance off
@@ -74,7 +76,8 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
             const double spread =
                 std::min(cell_extent_m * std::sqrt(1.0 - cos_t * cos_t) / cos_t, layer);
             const double se_spread = spread > noise_sigma ? spread / std::sqrt(12.0) : 0.0;
-            return {c.Mean() + c.high_end_above_mean_m, se_spread};
+            return {c.Mean() + c.high_end_above_mean_m + c.cap_above_mean_m,
+                    std::hypot(se_spread, c.cap_above_mean_m)};
         }
         if (!walls || var - noise_var <= wander) return {c.Mean(), 0.0};
         if (off_plane > noise_var + wander) return {c.Mean(), layer / std::sqrt(12.0)};

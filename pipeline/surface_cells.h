@@ -63,6 +63,9 @@ struct LayerCell : CellStats {
     // Set by the caller where the cell is a sloped patch to be read at its high end (TopBound):
     // how far above the readings' mean that end lies.
     double high_end_above_mean_m = 0.0;
+    // Set by the caller where the cell is the top of a smooth cap (a bag's crown, a lying tube's
+    // crest, TopBound): how far the cap's top lies above the readings' mean.
+    double cap_above_mean_m = 0.0;
 };
 
 // Returns Φ⁻¹(0.5^(1/m)): the median of the largest of m standard normal draws.
