@@ -86,9 +86,10 @@ struct EnclosingCuboid {
 // Returns the smallest enclosing cuboid of `cloud` (table frame, fused from `views` views), given
 // its face fit `box` (an error when the cloud has no box faces), or INSUFFICIENT_DATA when no
 // surface cell is seen. `agreement_m` is how closely the registered views agree (their ICP
-// RMSE): a face cell must stand out of its plane by more than that, beyond its noise, to count —
-// finer structure cannot be told from the fusion's own. `noise_sigma_m` is the sensor's noise
-// per point (the table top's about its fitted plane).
+// RMSE): faces whose offsets spread between the views by more than a few times that (a tube's
+// side, where each view sees its own tangent) are no flat faces. A face cell counts as standing
+// out by its own statistics (face_envelope.h), not by this figure, which is mostly the noise's.
+// `noise_sigma_m` is the sensor's noise per point (the table top's about its fitted plane).
 Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result<BoxFit>& box,
                                            int views, double agreement_m, double noise_sigma_m,
                                            const EnvelopeConfig& config);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "pipeline/surface_cells.h"
@@ -103,9 +104,9 @@ struct FaceCells {
         const int m = static_cast<int>(judged.size());
         if (m == 0) return;
         const double k = UpperNormalQuantile(config.false_alarm / m);
-        std::unordered_map<std::size_t, int> alone;
+        std::unordered_set<std::size_t> alone;
         for (const Judged& c : judged) {
-            if (c.st.Mean() - k * c.se > threshold) alone[c.key] = 1;
+            if (c.st.Mean() - k * c.se > threshold) alone.insert(c.key);
         }
         auto stands_out = [&](const Judged& c) {
             if (alone.count(c.key) == 0) return false;
