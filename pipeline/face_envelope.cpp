@@ -108,33 +108,36 @@ struct FaceCells {
         for (const Judged& c : judged) {
             if (c.st.Mean() - k * c.se > threshold) alone.insert(c.key);
         }
-        auto stands_out = [&](const Judged& c) {
-            if (alone.count(c.key) == 0) return false;
+        // Standing out beside a neighbour that does too, decided once per cell.
+        std::vector<bool> out_flags(judged.size(), false);
+        const Judged* top = nullptr;
+        for (std::size_t n = 0; n < judged.size(); ++n) {
+            const Judged& c = judged[n];
+            if (alone.count(c.key) == 0) continue;
             const long key = static_cast<long>(c.key), col = key % na;
-            for (long dj = -1; dj <= 1; ++dj) {
+            for (long dj = -1; dj <= 1 && !out_flags[n]; ++dj) {
                 for (long di = -1; di <= 1; ++di) {
                     const long other = key + dj * na + di;
                     if ((di != 0 || dj != 0) && col + di >= 0 && col + di < na && other >= 0 &&
                         alone.count(static_cast<std::size_t>(other)) != 0) {
-                        return true;
+                        out_flags[n] = true;
+                        break;
                     }
                 }
             }
-            return false;
-        };
-        const Judged* top = nullptr;
-        for (const Judged& c : judged) {
-            if (stands_out(c) && (top == nullptr || c.st.Mean() > top->st.Mean())) top = &c;
+            if (out_flags[n] && (top == nullptr || c.st.Mean() > top->st.Mean())) top = &c;
         }
         if (top == nullptr) return;
-        auto competes = [&](const Judged& c) {
-            return stands_out(c) && c.st.Mean() >= top->st.Mean() - 2.0 * (c.se + top->se);
+        auto competes = [&](std::size_t n) {
+            return out_flags[n] &&
+                   judged[n].st.Mean() >= top->st.Mean() - 2.0 * (judged[n].se + top->se);
         };
         int contenders = 0;
-        for (const Judged& c : judged) contenders += competes(c) ? 1 : 0;
+        for (std::size_t n = 0; n < judged.size(); ++n) contenders += competes(n) ? 1 : 0;
         const double z = MedianOfLargest(contenders);
-        for (const Judged& c : judged) {
-            if (!competes(c)) continue;
+        for (std::size_t n = 0; n < judged.size(); ++n) {
+            if (!competes(n)) continue;
+            const Judged& c = judged[n];
             const double excess = c.st.Mean() - z * c.se;
             if (excess > out->excess_m) {
                 out->excess_m = excess;

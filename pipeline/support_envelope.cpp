@@ -34,19 +34,22 @@ void MarkSlopesToReadHigh(CellGrid<LayerCell>* grid, double sigma, const Envelop
     for (std::size_t k = 0; k < grid->cells.size(); ++k) {
         if (grid->cells[k].n >= config.min_cell_points) slopes[k] = grid->cells[k].BestSlope(sigma);
     }
+    auto slope_at = [&](int i, int j) -> const LayerCell::Slope& {
+        return slopes[static_cast<std::size_t>(grid->CellAt(i, j) - grid->cells.data())];
+    };
     for (int j = 0; j < grid->nb; ++j) {
         for (int i = 0; i < grid->na; ++i) {
-            const std::size_t k = static_cast<std::size_t>(j) * grid->na + i;
-            if (!(slopes[k].rise > sigma)) continue;
-            const Eigen::Vector2d down = -slopes[k].gradient.normalized();
+            const LayerCell::Slope& here = slope_at(i, j);
+            if (!(here.rise > sigma)) continue;
+            const Eigen::Vector2d down = -here.gradient.normalized();
             const int di = static_cast<int>(std::lround(std::sqrt(2.0) * down.x()));
             const int dj = static_cast<int>(std::lround(std::sqrt(2.0) * down.y()));
             const int ni = std::clamp(i + std::clamp(di, -1, 1), 0, grid->na - 1);
             const int nj = std::clamp(j + std::clamp(dj, -1, 1), 0, grid->nb - 1);
-            const LayerCell::Slope& next = slopes[static_cast<std::size_t>(nj) * grid->na + ni];
+            const LayerCell::Slope& next = slope_at(ni, nj);
             if ((ni != i || nj != j) && next.rise > sigma &&
                 next.gradient.normalized().dot(-down) > 0.5) {
-                grid->cells[k].high_end_above_mean_m = std::sqrt(3.0) * slopes[k].rise;
+                grid->CellAt(i, j)->high_end_above_mean_m = std::sqrt(3.0) * here.rise;
             }
         }
     }
@@ -60,27 +63,22 @@ void MarkSlopesToReadHigh(CellGrid<LayerCell>* grid, double sigma, const Envelop
 // than the layer's depth away is another surface (an opened panel's tip over the box's top), not
 // the cap curving on, and the cell is left as it is.
 void MarkCapTops(CellGrid<LayerCell>* grid, double sigma, const EnvelopeConfig& config) {
-    auto at = [grid](int i, int j) -> const LayerCell* {
-        if (i < 0 || j < 0 || i >= grid->na || j >= grid->nb) return nullptr;
-        return &grid->cells[static_cast<std::size_t>(j) * grid->na + i];
-    };
     const double layer = config.layer_sigmas * sigma;
     std::vector<double> cap(grid->cells.size(), 0.0);
-    for (int j = 0; j < grid->nb; ++j) {
-        for (int i = 0; i < grid->na; ++i) {
-            const LayerCell& c = *at(i, j);
-            if (c.n < config.min_cell_points || c.high_end_above_mean_m > 0.0) continue;
-            double laplacian = 0.0;
-            bool smooth = true;
-            for (const auto& [di, dj] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
-                const LayerCell* nb = at(i + di, j + dj);
-                smooth = smooth && nb != nullptr && nb->n >= config.min_cell_points &&
-                         std::abs(nb->Mean() - c.Mean()) <= layer;
-                if (smooth) laplacian += nb->Mean() - c.Mean();
-            }
-            if (smooth)
-                cap[static_cast<std::size_t>(j) * grid->na + i] = std::max(0.0, -laplacian / 24.0);
+    for (std::size_t k = 0; k < grid->cells.size(); ++k) {
+        const LayerCell& c = grid->cells[k];
+        if (c.n < config.min_cell_points || c.high_end_above_mean_m > 0.0) continue;
+        const int i = static_cast<int>(k % static_cast<std::size_t>(grid->na));
+        const int j = static_cast<int>(k / static_cast<std::size_t>(grid->na));
+        double laplacian = 0.0;
+        bool smooth = true;
+        for (const auto& [di, dj] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+            const LayerCell* nb = grid->CellAt(i + di, j + dj);
+            smooth = smooth && nb != nullptr && nb->n >= config.min_cell_points &&
+                     std::abs(nb->Mean() - c.Mean()) <= layer;
+            if (smooth) laplacian += nb->Mean() - c.Mean();
         }
+        if (smooth) cap[k] = std::max(0.0, -laplacian / 24.0);
     }
     for (std::size_t k = 0; k < cap.size(); ++k) grid->cells[k].cap_above_mean_m = cap[k];
 }
@@ -131,9 +129,7 @@ void KeepGapsOnly(const CellGrid<LayerCell>& fine, CellGrid<LayerCell>& coarse,
         for (int i = 0; i < fine.na; ++i) {
             const LayerCell& f = fine.cells[static_cast<std::size_t>(j) * fine.na + i];
             if (f.n < config.min_cell_points) continue;
-            const int ci = i / 2, cj = j / 2;
-            if (ci >= coarse.na || cj >= coarse.nb) continue;
-            coarse.cells[static_cast<std::size_t>(cj) * coarse.na + ci] = LayerCell{};
+            if (LayerCell* c = coarse.CellAt(i / 2, j / 2)) *c = LayerCell{};
         }
     }
 }

@@ -48,12 +48,12 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
     //    layer's depth), and its high end lies somewhere in that spread above the mean (a
     //    panel opened at 30 or 60 degrees): the uncertainty carries the spread's standard
     //    deviation, spread / √12. A cell its caller marks with `high_end_above_mean_m` (a
-    //    sloped patch of the top that continues downhill, TopBound) is read at that high end
+    //    sloped patch that continues downhill, support_envelope.cpp) is read at that high end
     //    instead: spread evenly over the cell, its readings reach √3 standard deviations of
     //    their plane's rise above their mean; one marked with `cap_above_mean_m` (the top of
-    //    a smooth cap) that far above its mean, uncertain by as much. (At any looser limit than
-    //    60 degrees, two faces
-    //    meeting in a cell pass for one tilted surface and widen flat boxes by millimetres.)
+    //    a smooth cap) that far above its mean, uncertain by as much. (At any looser limit
+    //    than 60 degrees, two faces meeting in a cell pass for one tilted surface and widen
+    //    flat boxes by millimetres.)
     //  - One surface crossing the layer — a wall running along the direction, a steep panel,
     //    a tube's flank: its readings lie on one plane (their variance off
     //    it is the noise's) and spread evenly over the layer, so its high end lies √3 standard
@@ -83,33 +83,36 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
         if (off_plane > noise_var + wander) return {c.Mean(), layer / std::sqrt(12.0)};
         return {c.Mean() + std::sqrt(3.0 * (var - noise_var)), 0.0};
     };
-    auto reach = [&](const LayerCell& c) { return reach_of(c).value; };
-    auto slope_se = [&](const LayerCell& c) { return reach_of(c).extra_se; };
+    // Each judged cell's reach, once: it costs an eigen-decomposition of the cell's scatter.
+    std::vector<Reach> reaches(cells.size(), Reach{-INFINITY, 0.0});
     int m = 0;
     double top = -INFINITY, top_se = 0.0;
-    for (const LayerCell& c : cells) {
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+        const LayerCell& c = cells[k];
         if (c.n < config.min_cell_points) continue;
         ++m;
-        if (reach(c) > top) {
-            top = reach(c);
+        reaches[k] = reach_of(c);
+        if (reaches[k].value > top) {
+            top = reaches[k].value;
             top_se = c.StdError();
         }
     }
     *judged = m;
     if (m == 0) return -INFINITY;
-    auto competes = [&](const LayerCell& c) {
-        return c.n >= config.min_cell_points && reach(c) >= top - 2.0 * (c.StdError() + top_se);
+    auto competes = [&](std::size_t k) {
+        return cells[k].n >= config.min_cell_points &&
+               reaches[k].value >= top - 2.0 * (cells[k].StdError() + top_se);
     };
     int contenders = 0;
-    for (const LayerCell& c : cells) contenders += competes(c) ? 1 : 0;
+    for (std::size_t k = 0; k < cells.size(); ++k) contenders += competes(k) ? 1 : 0;
     const double z = MedianOfLargest(contenders);
     double best = -INFINITY;
-    for (const LayerCell& c : cells) {
-        if (!competes(c)) continue;
-        const double bound = reach(c) - z * c.StdError();
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+        if (!competes(k)) continue;
+        const double bound = reaches[k].value - z * cells[k].StdError();
         if (bound > best) {
             best = bound;
-            *se = std::hypot(c.StdError(), slope_se(c));
+            *se = std::hypot(cells[k].StdError(), reaches[k].extra_se);
         }
     }
     return best;

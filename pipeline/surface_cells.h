@@ -60,8 +60,8 @@ struct LayerCell : CellStats {
         double rise = 0.0;
     };
     Slope BestSlope(double noise_sigma) const;
-    // Set by the caller where the cell is a sloped patch to be read at its high end (TopBound):
-    // how far above the readings' mean that end lies.
+    // Set by the caller where the cell is a sloped patch to be read at its high end (the top's
+    // or a side layer's, support_envelope.cpp): how far above the readings' mean that end lies.
     double high_end_above_mean_m = 0.0;
     // Set by the caller where the cell is the top of a smooth cap (a bag's crown, a lying tube's
     // crest, TopBound): how far the cap's top lies above the readings' mean.
@@ -95,12 +95,16 @@ struct CellGrid {
         nb = std::max(1, static_cast<int>(std::ceil((b_hi - b_lo) / cell_b)));
         cells.resize(static_cast<std::size_t>(na) * static_cast<std::size_t>(nb));
     }
-    Cell* At(double a, double b) {
-        const int i = static_cast<int>(std::floor((a - a0) / da));
-        const int j = static_cast<int>(std::floor((b - b0) / db));
+    // The cell in column i, row j; nullptr outside the grid.
+    Cell* CellAt(int i, int j) {
         if (i < 0 || j < 0 || i >= na || j >= nb) return nullptr;
         return &cells[static_cast<std::size_t>(j) * static_cast<std::size_t>(na) +
                       static_cast<std::size_t>(i)];
+    }
+    // The cell holding the point (a, b); nullptr outside the grid.
+    Cell* At(double a, double b) {
+        return CellAt(static_cast<int>(std::floor((a - a0) / da)),
+                      static_cast<int>(std::floor((b - b0) / db)));
     }
 };
 
