@@ -83,6 +83,60 @@ void MarkCapTops(CellGrid<LayerCell>* grid, double sigma, const EnvelopeConfig& 
     for (std::size_t k = 0; k < cap.size(); ++k) grid->cells[k].cap_above_mean_m = cap[k];
 }
 
+// A ridge of the top (an opened panel's tip: its outer face falling away steeply on one side,
+// its end on the other) holds its highest point inside its cell, and its faces spread the
+// readings evenly down the layer from there: it lies √3 standard deviations of that spread above
+// their mean, the spread being the readings' height variance less the noise's about their best
+// plane. Neither face need go on into the next cell (MarkSlopesToReadHigh), and a steep face's
+// sliver of the layer is too narrow to make a slope's plane. A spread counts when it exceeds the
+// noise by more than a sample variance wanders (three of its standard errors).
+// A top's rim looks the same in its cell (the top and the wall below it share the layer), but
+// the top goes on into a neighbouring cell, and such a cell is left as it is: beside a cell that
+// reads higher (by two of their standard errors: a cap's crest, a slope going on up), or one
+// that reads as high without a spread, its readings covering at least half of it each way (a
+// level top; not a ridge's strip that happens to show no spread).
+void MarkRidgesToReadHigh(CellGrid<LayerCell>* grid, const EnvelopeConfig& config) {
+    // Half a cell's width, evenly covered, has this variance across (the narrower way).
+    const double half_cover = std::pow(std::min(grid->da, grid->db) / 2.0, 2) / 12.0;
+    struct Spread {
+        bool judged = false, level = false;
+        double variance = 0.0;
+    };
+    std::vector<Spread> spread(grid->cells.size());
+    for (std::size_t k = 0; k < grid->cells.size(); ++k) {
+        const LayerCell& c = grid->cells[k];
+        if (c.n < config.min_cell_points) continue;
+        double noise_var = 0.0;
+        c.Facing(&noise_var);
+        const double variance = c.Variance() - noise_var;
+        const double wander = 3.0 * noise_var * std::sqrt(2.0 / (c.n - 1));
+        spread[k] = {true, variance <= wander && c.NarrowerExtentVariance() >= half_cover,
+                     variance};
+    }
+    for (int j = 0; j < grid->nb; ++j) {
+        for (int i = 0; i < grid->na; ++i) {
+            LayerCell& c = *grid->CellAt(i, j);
+            const Spread& here = spread[static_cast<std::size_t>(&c - grid->cells.data())];
+            if (!here.judged || here.level || c.high_end_above_mean_m > 0.0 ||
+                c.cap_above_mean_m > 0.0) {
+                continue;
+            }
+            bool rim = false;
+            for (int dj = -1; dj <= 1 && !rim; ++dj) {
+                for (int di = -1; di <= 1 && !rim; ++di) {
+                    const LayerCell* nb = grid->CellAt(i + di, j + dj);
+                    if (nb == nullptr || nb == &c || nb->n < config.min_cell_points) continue;
+                    const double apart = 2.0 * (nb->StdError() + c.StdError());
+                    rim = nb->Mean() > c.Mean() + apart ||
+                          (spread[static_cast<std::size_t>(nb - grid->cells.data())].level &&
+                           nb->Mean() >= c.Mean() - apart);
+                }
+            }
+            if (!rim) c.high_end_above_mean_m = std::sqrt(3.0 * here.variance);
+        }
+    }
+}
+
 // The outer layers in direction u (front) and -u (back), over cells of (across, up).
 struct Layers {
     CellGrid<LayerCell> front, back;
@@ -194,6 +248,7 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double ra
     }
     MarkSlopesToReadHigh(&grid, sigma, config);
     MarkCapTops(&grid, sigma, config);
+    MarkRidgesToReadHigh(&grid, config);
     int judged = 0;
     return LargestBound(grid.cells, config, sigma, cell, se, &judged);
 }

@@ -38,6 +38,26 @@ LayerCell::Slope LayerCell::BestSlope(double noise_sigma) const {
     return out;
 }
 
+double LayerCell::NarrowerExtentVariance() const {
+    const Eigen::Vector2d mean = sum3.head<2>() / n;
+    const Eigen::Matrix2d cov = sum_outer.topLeftCorner<2, 2>() / n - mean * mean.transpose();
+    const double half_trace = 0.5 * cov.trace();
+    const double det = cov.determinant();
+    return half_trace - std::sqrt(std::max(0.0, half_trace * half_trace - det));
+}
+
+double HighEndSe(double variance, double spread_variance, int n) {
+    if (!(spread_variance > 0.0) || n < 2) return 0.0;
+    // √(3 s²) moves by 3 / (2 √(3 s²)) per unit of s², whose estimate (a sample variance less
+    // the noise's) wanders by the sample variance's standard error, σ² √(2 / (n − 1)). That
+    // slope grows without end as s² shrinks, but the high end lies between the mean and √3
+    // standard deviations of all the readings above it: known at least as well as a value
+    // anywhere in that interval, its width over √12.
+    const double delta =
+        3.0 * variance * std::sqrt(2.0 / (n - 1)) / (2.0 * std::sqrt(3.0 * spread_variance));
+    return std::min(delta, std::sqrt(variance) / 2.0);
+}
+
 double MedianOfLargest(int m) { return UpperNormalQuantile(1.0 - std::pow(0.5, 1.0 / m)); }
 
 double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
@@ -57,7 +77,8 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
     //  - One surface crossing the layer — a wall running along the direction, a steep panel,
     //    a tube's flank: its readings lie on one plane (their variance off
     //    it is the noise's) and spread evenly over the layer, so its high end lies √3 standard
-    //    deviations of that spread beyond the noise above their mean.
+    //    deviations of that spread beyond the noise above their mean, as well as that
+    //    spread's sample variance tells (HighEndSe).
     //  - Two surfaces sharing the cell (a corner: a face and the end of the next one): neither
     //    model holds. The mean is the safe reach, and the uncertainty carries the layer.
     // A variance must exceed the noise's by more than a sample variance wanders (three of its
@@ -70,7 +91,7 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
     auto reach_of = [&](const LayerCell& c) -> Reach {
         double off_plane = 0.0;
         const double cos_t = std::min(1.0, c.Facing(&off_plane));
-        const double var = std::max(0.0, (c.sum_sq - c.sum * c.sum / c.n) / std::max(1, c.n - 1));
+        const double var = c.Variance();
         const double wander = 3.0 * noise_var * std::sqrt(2.0 / (c.n - 1));
         if (cos_t >= 0.5) {
             const double spread =
@@ -81,7 +102,8 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
         }
         if (!walls || var - noise_var <= wander) return {c.Mean(), 0.0};
         if (off_plane > noise_var + wander) return {c.Mean(), layer / std::sqrt(12.0)};
-        return {c.Mean() + std::sqrt(3.0 * (var - noise_var)), 0.0};
+        return {c.Mean() + std::sqrt(3.0 * (var - noise_var)),
+                HighEndSe(var, var - noise_var, c.n)};
     };
     // Each judged cell's reach, once: it costs an eigen-decomposition of the cell's scatter.
     std::vector<Reach> reaches(cells.size(), Reach{-INFINITY, 0.0});

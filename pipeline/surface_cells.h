@@ -28,12 +28,11 @@ struct CellStats {
         sum_sq += x * x;
     }
     double Mean() const { return sum / n; }
-    // Standard error of the mean (sample variance; at least a tenth of a millimetre of spread,
-    // so that a cell of identical readings is not infinitely certain).
-    double StdError() const {
-        const double var = std::max(0.0, (sum_sq - sum * sum / n) / std::max(1, n - 1));
-        return std::sqrt(std::max(var, 1e-8) / n);
-    }
+    // The sample variance.
+    double Variance() const { return std::max(0.0, (sum_sq - sum * sum / n) / std::max(1, n - 1)); }
+    // Standard error of the mean (at least a tenth of a millimetre of spread, so that a cell of
+    // identical readings is not infinitely certain).
+    double StdError() const { return std::sqrt(std::max(Variance(), 1e-8) / n); }
 };
 
 // A cell of an outer layer: the readings' offsets along the direction judged (as CellStats) and
@@ -60,6 +59,8 @@ struct LayerCell : CellStats {
         double rise = 0.0;
     };
     Slope BestSlope(double noise_sigma) const;
+    // The variance of the readings' (a, b) positions along the way they spread least.
+    double NarrowerExtentVariance() const;
     // Set by the caller where the cell is a sloped patch to be read at its high end (the top's
     // or a side layer's, support_envelope.cpp): how far above the readings' mean that end lies.
     double high_end_above_mean_m = 0.0;
@@ -67,6 +68,11 @@ struct LayerCell : CellStats {
     // crest, TopBound): how far the cap's top lies above the readings' mean.
     double cap_above_mean_m = 0.0;
 };
+
+// The standard error of a surface's high end read √3 standard deviations of its spread above
+// its readings' mean (readings spread evenly down from it): `spread_variance` is the readings'
+// sample `variance` (of `n`) less the noise's.
+double HighEndSe(double variance, double spread_variance, int n);
 
 // Returns Φ⁻¹(0.5^(1/m)): the median of the largest of m standard normal draws.
 double MedianOfLargest(int m);
