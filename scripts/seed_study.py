@@ -1,0 +1,83 @@
+#!/usr/bin/env python3
+"""Are the bounds calibrated? Renders one case of the accuracy suite (tests/accuracy/cases.json)
+with many noise seeds, measures each (`boxd measure`), and prints per dimension the errors' mean
+and standard deviation against the median 95% bound: a calibrated bound is about 1.96 standard
+deviations of the error, and the median bound about 2.9 times the median |error|. With --split,
+each run's debug log gives the bound's parts (1 sigma, mm): the faces' own and the registration's.
+
+Usage: scripts/seed_study.py [--boxd build/daemon/boxd] [--case reference] [--seeds 16]
+                             [--first 100] [--split]
+"""
+import argparse
+import json
+import os
+import re
+import statistics
+import subprocess
+import tempfile
+from concurrent.futures import ThreadPoolExecutor
+
+from early_stop_study import HERE, KEYS, synth_args
+
+SPLIT = re.compile(r"uncertainty: faces ([\d.]+) ([\d.]+) ([\d.]+) mm, registration ([\d.]+) "
+                   r"([\d.]+) mm")
+
+
+def measure(boxd, case, seed, tmp, split):
+    out = os.path.join(tmp, f"seed{seed}")
+    angles = [round(360.0 * k / case["poses"], 6) for k in range(case["poses"])]
+    subprocess.run([boxd, *synth_args(dict(case, seed=seed), out, angles)], capture_output=True,
+                   check=True)
+    env = dict(os.environ, BOXD_LOG_LEVEL="debug") if split else None
+    run = subprocess.run([boxd, "measure", "--session", out], capture_output=True, text=True,
+                         env=env)
+    r = json.loads(run.stdout)
+    if r["status"] != "ok":
+        return seed, None, None, r.get("reason", {}).get("code")
+    with open(os.path.join(out, "session.json")) as f:
+        truth = json.load(f)["ground_truth"]
+    err = [(r["dimensions"][k] - truth[k]) * 1e3 for k in KEYS]
+    bound = [r["uncertainty_m"][k] * 1e3 for k in KEYS]
+    parts = SPLIT.search(run.stderr) if split else None
+    return seed, err, bound, parts.groups() if parts else ""
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--boxd", default=os.path.join(HERE, "..", "build", "daemon", "boxd"))
+    p.add_argument("--case", default="reference")
+    p.add_argument("--seeds", type=int, default=16)
+    p.add_argument("--first", type=int, default=100)
+    p.add_argument("--split", action="store_true")
+    args = p.parse_args()
+    with open(os.path.join(HERE, "..", "tests", "accuracy", "cases.json")) as f:
+        cases = {c["name"]: c for c in json.load(f)["cases"]}
+    if args.case not in cases:
+        raise SystemExit(f"no case '{args.case}' in tests/accuracy/cases.json")
+    case = cases[args.case]
+    seeds = range(args.first, args.first + args.seeds)
+    with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(2) as pool:
+        runs = list(pool.map(lambda s: measure(args.boxd, case, s, tmp, args.split), seeds))
+    done = [r for r in runs if r[1] is not None]
+    for seed, err, bound, extra in runs:
+        if err is None:
+            print(f"seed {seed}: refused {extra}")
+            continue
+        print("seed %d: error %6.2f %6.2f %6.2f mm, bound %5.2f %5.2f %5.2f mm %s" %
+              (seed, *err, *bound, ("faces %s %s %s, registration %s %s" % extra) if extra else ""))
+    if not done:
+        raise SystemExit("no run measured")
+    for i, name in enumerate(("length", "width", "height")):
+        e = [r[1][i] for r in done]
+        b = [r[2][i] for r in done]
+        within = sum(abs(x) <= y for x, y in zip(e, b))
+        med_e = statistics.median(abs(x) for x in e)
+        print("%-6s: error mean %+.3f sd %.3f mm, median |error| %.3f mm, median bound %.3f mm "
+              "(%.1fx), %d of %d within" % (name, statistics.mean(e), statistics.pstdev(e), med_e,
+                                           statistics.median(b),
+                                           statistics.median(b) / med_e if med_e else float("inf"),
+                                           within, len(done)))
+
+
+if __name__ == "__main__":
+    main()
