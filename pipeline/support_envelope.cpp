@@ -142,35 +142,48 @@ struct Layers {
     CellGrid<LayerCell> front, back;
 };
 
-Layers BuildLayers(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector2d& u, double sigma,
-                   double radius, double top, double cell_along, double cell_height,
-                   const EnvelopeConfig& config) {
+// The outer layers of several grids (cells of `sizes`: along, up), each reading projected once:
+// the readings' extremes per cell in one pass, the layers within config.layer_sigmas sigma of
+// them in a second.
+std::vector<Layers> BuildLayers(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector2d& u,
+                                double sigma, double radius, double top,
+                                const std::vector<std::pair<double, double>>& sizes,
+                                const EnvelopeConfig& config) {
     const Eigen::Vector2d v(-u.y(), u.x());
-    Layers out{CellGrid<LayerCell>(-radius, radius, 0.0, top, cell_along, cell_height),
-               CellGrid<LayerCell>(-radius, radius, 0.0, top, cell_along, cell_height)};
-    CellGrid<LayerCell>& front = out.front;
-    std::vector<double> max_s(front.cells.size(), -INFINITY), min_s(front.cells.size(), INFINITY);
-    auto index = [&front](const LayerCell* c) {
-        return static_cast<std::size_t>(c - front.cells.data());
-    };
-    for (const Eigen::Vector3f& p : pts) {
-        const Eigen::Vector2d q = p.head<2>().cast<double>();
-        if (LayerCell* c = front.At(v.dot(q), p.z())) {
-            const std::size_t k = index(c);
-            const double s = u.dot(q);
-            max_s[k] = std::max(max_s[k], s);
-            min_s[k] = std::min(min_s[k], s);
+    const std::size_t grids = sizes.size();
+    std::vector<Layers> out;
+    std::vector<std::vector<double>> max_s, min_s;
+    for (const auto& [along, up] : sizes) {
+        out.push_back({CellGrid<LayerCell>(-radius, radius, 0.0, top, along, up),
+                       CellGrid<LayerCell>(-radius, radius, 0.0, top, along, up)});
+        max_s.emplace_back(out.back().front.cells.size(), -INFINITY);
+        min_s.emplace_back(out.back().front.cells.size(), INFINITY);
+    }
+    // Each reading's (across, along), and its cell in each grid (-1: outside it).
+    std::vector<Eigen::Vector2d> across_along(pts.size());
+    std::vector<long> cell(pts.size() * grids, -1);
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+        const Eigen::Vector2d q = pts[i].head<2>().cast<double>();
+        across_along[i] = {v.dot(q), u.dot(q)};
+        for (std::size_t g = 0; g < grids; ++g) {
+            CellGrid<LayerCell>& front = out[g].front;
+            const LayerCell* c = front.At(across_along[i].x(), pts[i].z());
+            if (c == nullptr) continue;
+            const auto k = static_cast<std::size_t>(c - front.cells.data());
+            cell[i * grids + g] = static_cast<long>(k);
+            max_s[g][k] = std::max(max_s[g][k], across_along[i].y());
+            min_s[g][k] = std::min(min_s[g][k], across_along[i].y());
         }
     }
     const double layer = config.layer_sigmas * sigma;
-    for (const Eigen::Vector3f& p : pts) {
-        const Eigen::Vector2d q = p.head<2>().cast<double>();
-        LayerCell* c = front.At(v.dot(q), p.z());
-        if (c == nullptr) continue;
-        const std::size_t k = index(c);
-        const double s = u.dot(q), t = v.dot(q);
-        if (s >= max_s[k] - layer) c->Add3(t, p.z(), s);
-        if (s <= min_s[k] + layer) out.back.cells[k].Add3(-t, p.z(), -s);
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+        const double t = across_along[i].x(), s = across_along[i].y(), z = pts[i].z();
+        for (std::size_t g = 0; g < grids; ++g) {
+            if (cell[i * grids + g] < 0) continue;
+            const auto k = static_cast<std::size_t>(cell[i * grids + g]);
+            if (s >= max_s[g][k] - layer) out[g].front.cells[k].Add3(t, z, s);
+            if (s <= min_s[g][k] + layer) out[g].back.cells[k].Add3(-t, z, -s);
+        }
     }
     return out;
 }
@@ -198,14 +211,23 @@ void KeepGapsOnly(const CellGrid<LayerCell>& fine, CellGrid<LayerCell>& coarse,
 // surface, and on a noisy cloud would pass the ends of the faces that meet in it for walls
 // reaching millimetres farther). A small cell where the surface slopes away inward, and goes on
 // sloping in the next cell (an opened panel rising from its hinge), is read at its outer end.
+// Rows half as tall compete too: what stands out over less than a row's height (an opened
+// panel's corner at its hinge, 2-3 mm out over a millimetre or two of height) shares its row
+// with the side below it, which holds most of the readings and takes the layer's mean; half a
+// row holds it apart. Their cells hold half the readings, and the noise correction and their
+// standard errors count that.
 Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double sigma,
                      double radius, double top, const EnvelopeConfig& config) {
     const Eigen::Vector2d u(std::cos(phi), std::sin(phi));
     const double along = config.cell_along_m, height = config.cell_height_m;
-    Layers fine = BuildLayers(pts, u, sigma, radius, top, along, height, config);
-    MarkSlopesToReadHigh(&fine.front, sigma, config);
-    MarkSlopesToReadHigh(&fine.back, sigma, config);
-    Layers coarse = BuildLayers(pts, u, sigma, radius, top, 2.0 * along, 2.0 * height, config);
+    std::vector<Layers> layers =
+        BuildLayers(pts, u, sigma, radius, top,
+                    {{along, height}, {2.0 * along, 2.0 * height}, {along, height / 2.0}}, config);
+    Layers &fine = layers[0], &coarse = layers[1], &thin = layers[2];
+    for (Layers* l : {&fine, &thin}) {
+        MarkSlopesToReadHigh(&l->front, sigma, config);
+        MarkSlopesToReadHigh(&l->back, sigma, config);
+    }
     KeepGapsOnly(fine.front, coarse.front, config);
     KeepGapsOnly(fine.back, coarse.back, config);
     Support out;
@@ -223,6 +245,7 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
     for (bool forward : {true, false}) {
         farther(fine, std::max(along, height), forward, true);
         farther(coarse, 2.0 * std::max(along, height), forward, false);
+        farther(thin, std::max(along, height / 2.0), forward, true);
     }
     return out;
 }

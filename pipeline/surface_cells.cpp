@@ -85,8 +85,11 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
     // standard errors, σ² √(2 / (n − 1))) to count, or noise would pass for structure.
     const double layer = config.layer_sigmas * noise_sigma;
     const double noise_var = noise_sigma * noise_sigma;
+    // A reach, the uncertainty its reading adds to the mean's (`extra_se`), and how far noise
+    // alone moves it (`noise_se`: the mean's standard error, and a wall end's high-end reading,
+    // HighEndSe, which wanders from cell to cell as the readings fall).
     struct Reach {
-        double value, extra_se;
+        double value, extra_se, noise_se;
     };
     auto reach_of = [&](const LayerCell& c) -> Reach {
         double off_plane = 0.0;
@@ -98,15 +101,18 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
                 std::min(cell_extent_m * std::sqrt(1.0 - cos_t * cos_t) / cos_t, layer);
             const double se_spread = spread > noise_sigma ? spread / std::sqrt(12.0) : 0.0;
             return {c.Mean() + c.high_end_above_mean_m + c.cap_above_mean_m,
-                    std::hypot(se_spread, c.cap_above_mean_m)};
+                    std::hypot(se_spread, c.cap_above_mean_m), c.StdError()};
         }
-        if (!walls || var - noise_var <= wander) return {c.Mean(), 0.0};
-        if (off_plane > noise_var + wander) return {c.Mean(), layer / std::sqrt(12.0)};
-        return {c.Mean() + std::sqrt(3.0 * (var - noise_var)),
-                HighEndSe(var, var - noise_var, c.n)};
+        if (!walls || var - noise_var <= wander) return {c.Mean(), 0.0, c.StdError()};
+        if (off_plane > noise_var + wander) {
+            return {c.Mean(), layer / std::sqrt(12.0), c.StdError()};
+        }
+        const double high_end_se = HighEndSe(var, var - noise_var, c.n);
+        return {c.Mean() + std::sqrt(3.0 * (var - noise_var)), high_end_se,
+                std::hypot(c.StdError(), high_end_se)};
     };
     // Each judged cell's reach, once: it costs an eigen-decomposition of the cell's scatter.
-    std::vector<Reach> reaches(cells.size(), Reach{-INFINITY, 0.0});
+    std::vector<Reach> reaches(cells.size(), Reach{-INFINITY, 0.0, 0.0});
     int m = 0;
     double top = -INFINITY, top_se = 0.0;
     for (std::size_t k = 0; k < cells.size(); ++k) {
@@ -116,14 +122,14 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
         reaches[k] = reach_of(c);
         if (reaches[k].value > top) {
             top = reaches[k].value;
-            top_se = c.StdError();
+            top_se = reaches[k].noise_se;
         }
     }
     *judged = m;
     if (m == 0) return -INFINITY;
     auto competes = [&](std::size_t k) {
         return cells[k].n >= config.min_cell_points &&
-               reaches[k].value >= top - 2.0 * (cells[k].StdError() + top_se);
+               reaches[k].value >= top - 2.0 * (reaches[k].noise_se + top_se);
     };
     int contenders = 0;
     for (std::size_t k = 0; k < cells.size(); ++k) contenders += competes(k) ? 1 : 0;
@@ -131,7 +137,7 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
     double best = -INFINITY;
     for (std::size_t k = 0; k < cells.size(); ++k) {
         if (!competes(k)) continue;
-        const double bound = reaches[k].value - z * cells[k].StdError();
+        const double bound = reaches[k].value - z * reaches[k].noise_se;
         if (bound > best) {
             best = bound;
             *se = std::hypot(cells[k].StdError(), reaches[k].extra_se);

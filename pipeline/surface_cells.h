@@ -77,10 +77,13 @@ double HighEndSe(double variance, double spread_variance, int n);
 // Returns Φ⁻¹(0.5^(1/m)): the median of the largest of m standard normal draws.
 double MedianOfLargest(int m);
 
-// How far the surface reaches along the cells' axis: the cells whose means could be the largest
-// (within two standard errors of it) compete, and the largest of their means is corrected by the
-// median of the largest of that many noise draws — noise alone then moves the estimate neither
-// out nor in. A flat face has many such cells (a large correction), a tube's tangent few.
+// How far the surface reaches along the cells' axis: the cells whose reaches could be the largest
+// (within two standard errors of it) compete, and the largest of their reaches is corrected by
+// the median of the largest of that many noise draws — noise alone then moves the estimate
+// neither out nor in. A flat face has many such cells (a large correction), a tube's tangent few.
+// A cell's noise is its mean's standard error, and where it reads a wall's end above its mean
+// the error of that reading too (HighEndSe): many small cells of a noisy wall would otherwise
+// offer one whose spread happened to come out wide.
 // `cell_extent_m` is the cells' larger side; `se` receives the chosen cell's standard error (with
 // a sloped surface's spread), `judged` the number of cells with enough points. Without `walls`
 // every cell reads as a surface facing the direction (its mean), none as a wall's end. Returns
