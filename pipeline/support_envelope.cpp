@@ -89,7 +89,7 @@ void MarkCapTops(CellGrid<LayerCell>* grid, double sigma, const EnvelopeConfig& 
 // their mean, the spread being the readings' height variance less the noise's about their best
 // plane. Neither face need go on into the next cell (MarkSlopesToReadHigh), and a steep face's
 // sliver of the layer is too narrow to make a slope's plane. A spread counts when it exceeds the
-// noise by more than a sample variance wanders (three of its standard errors).
+// noise by three of a sample variance's standard errors (SampleVarianceSe).
 // A top's rim looks the same in its cell (the top and the wall below it share the layer), but
 // the top goes on into a neighbouring cell, and such a cell is left as it is: beside a cell that
 // reads higher (by two of their standard errors: a cap's crest, a slope going on up), or one
@@ -109,7 +109,7 @@ void MarkRidgesToReadHigh(CellGrid<LayerCell>* grid, const EnvelopeConfig& confi
         double noise_var = 0.0;
         c.Facing(&noise_var);
         const double variance = c.Variance() - noise_var;
-        const double wander = 3.0 * noise_var * std::sqrt(2.0 / (c.n - 1));
+        const double wander = 3.0 * SampleVarianceSe(noise_var, c.n);
         spread[k] = {true, variance <= wander && c.NarrowerExtentVariance() >= half_cover,
                      variance};
     }

@@ -46,15 +46,19 @@ double LayerCell::NarrowerExtentVariance() const {
     return half_trace - std::sqrt(std::max(0.0, half_trace * half_trace - det));
 }
 
+double SampleVarianceSe(double variance, int n) {
+    return variance * std::sqrt(2.0 / std::max(1, n - 1));
+}
+
 double HighEndSe(double variance, double spread_variance, int n) {
     if (!(spread_variance > 0.0) || n < 2) return 0.0;
     // √(3 s²) moves by 3 / (2 √(3 s²)) per unit of s², whose estimate (a sample variance less
-    // the noise's) wanders by the sample variance's standard error, σ² √(2 / (n − 1)). That
+    // the noise's) wanders by the sample variance's standard error (SampleVarianceSe). That
     // slope grows without end as s² shrinks, but the high end lies between the mean and √3
     // standard deviations of all the readings above it: known at least as well as a value
     // anywhere in that interval, its width over √12.
     const double delta =
-        3.0 * variance * std::sqrt(2.0 / (n - 1)) / (2.0 * std::sqrt(3.0 * spread_variance));
+        3.0 * SampleVarianceSe(variance, n) / (2.0 * std::sqrt(3.0 * spread_variance));
     return std::min(delta, std::sqrt(variance) / 2.0);
 }
 
@@ -81,8 +85,8 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
     //    spread's sample variance tells (HighEndSe).
     //  - Two surfaces sharing the cell (a corner: a face and the end of the next one): neither
     //    model holds. The mean is the safe reach, and the uncertainty carries the layer.
-    // A variance must exceed the noise's by more than a sample variance wanders (three of its
-    // standard errors, σ² √(2 / (n − 1))) to count, or noise would pass for structure.
+    // A variance must exceed the noise's by three of its standard errors to count
+    // (SampleVarianceSe).
     const double layer = config.layer_sigmas * noise_sigma;
     const double noise_var = noise_sigma * noise_sigma;
     // A reach, the uncertainty its reading adds to the mean's (`extra_se`), and how far noise
@@ -95,7 +99,7 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
         double off_plane = 0.0;
         const double cos_t = std::min(1.0, c.Facing(&off_plane));
         const double var = c.Variance();
-        const double wander = 3.0 * noise_var * std::sqrt(2.0 / (c.n - 1));
+        const double wander = 3.0 * SampleVarianceSe(noise_var, c.n);
         if (cos_t >= 0.5) {
             const double spread =
                 std::min(cell_extent_m * std::sqrt(1.0 - cos_t * cos_t) / cos_t, layer);

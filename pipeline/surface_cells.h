@@ -69,6 +69,11 @@ struct LayerCell : CellStats {
     double cap_above_mean_m = 0.0;
 };
 
+// How far a sample variance of `n` readings wanders from the true `variance` (its standard
+// error, σ² √(2 / (n − 1)) for normal readings). A variance must exceed the noise's by three of
+// these to count as structure, or noise would pass for it.
+double SampleVarianceSe(double variance, int n);
+
 // The standard error of a surface's high end read √3 standard deviations of its spread above
 // its readings' mean (readings spread evenly down from it): `spread_variance` is the readings'
 // sample `variance` (of `n`) less the noise's.
