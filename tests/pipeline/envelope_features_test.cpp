@@ -48,6 +48,44 @@ TEST(FaceEnvelope, PatchWithinOneCellIsNoExcess) {
     EXPECT_NEAR(f.cuboid->height_m, kH, 0.0005);
 }
 
+// Readings of a top: a surface sampled four times on jittered grids of `step` in its own (s, y)
+// coordinates, s in [0, s_len), y in [-y_half, y_half), each reading's height with `sigma` of
+// noise. A surface maps (s, y) to a point.
+template <typename Surface>
+void SampleSurface(const Surface& at, double s_len, double y_half, double sigma, std::mt19937& rng,
+                   std::vector<Eigen::Vector3f>* pts, double step = 0.002) {
+    std::uniform_real_distribution<double> jitter(0.0, step);
+    std::normal_distribution<double> noise(0.0, sigma);
+    for (int view = 0; view < 4; ++view) {
+        const double js = jitter(rng), jy = jitter(rng);
+        for (double s = js; s < s_len; s += step) {
+            for (double y = -y_half + jy; y < y_half; y += step) {
+                Eigen::Vector3d p = at(s, y);
+                p.z() += noise(rng);
+                pts->push_back(p.cast<float>());
+            }
+        }
+    }
+}
+
+// The mean over 30 clouds of the top's reading (over a grid `radius` about the axis) less the
+// truth `h`, the clouds drawn by `draw` from seeds `first_seed` on. The k-th cloud is drawn with
+// k / 30 (a position within a cell, say).
+template <typename Draw>
+double MeanTopError(double h, double sigma, const Draw& draw, double radius = 0.2,
+                    unsigned first_seed = 41) {
+    double sum = 0.0;
+    const int clouds = 30;
+    for (int k = 0; k < clouds; ++k) {
+        std::mt19937 rng(first_seed + static_cast<unsigned>(k));
+        std::vector<Eigen::Vector3f> pts;
+        draw(rng, static_cast<double>(k) / clouds, &pts);
+        double se = 0.0;
+        sum += envelope::TopBound(pts, sigma, radius, EnvelopeConfig{}, &se) - h;
+    }
+    return sum / clouds;
+}
+
 TEST(SupportEnvelope, CrownIsReadAtItsTop) {
     // A bag's crown: z = h - (x^2 + y^2) / (2 R), R = 0.1 m, read four times on a jittered 4 mm
     // grid with 1 mm of noise. The top's 24 mm cell over the crown averages (2 / R) c^2 / 24 =
@@ -57,63 +95,19 @@ TEST(SupportEnvelope, CrownIsReadAtItsTop) {
     // sloping neighbour (its mean too high, the Laplacian too small), and the correction for
     // the largest of the competing cells' noise counts cells a little below the crown.
     const double h = 0.3, radius_of_curvature = 0.1, sigma = 0.001;
-    double sum = 0.0;
-    const int clouds = 30;
-    for (int k = 0; k < clouds; ++k) {
-        std::mt19937 rng(static_cast<unsigned>(21 + k));
-        std::uniform_real_distribution<double> jitter(0.0, 0.004);
-        std::normal_distribution<double> noise(0.0, sigma);
-        std::vector<Eigen::Vector3f> pts;
-        for (int view = 0; view < 4; ++view) {
-            const double jx = jitter(rng), jy = jitter(rng);
-            for (double x = -0.1 + jx; x < 0.1; x += 0.004) {
-                for (double y = -0.1 + jy; y < 0.1; y += 0.004) {
-                    const double z = h - (x * x + y * y) / (2.0 * radius_of_curvature);
-                    pts.emplace_back(static_cast<float>(x), static_cast<float>(y),
-                                     static_cast<float>(z + noise(rng)));
-                }
-            }
-        }
-        double se = 0.0;
-        sum += envelope::TopBound(pts, sigma, 0.15, EnvelopeConfig{}, &se) - h;
-    }
-    EXPECT_GT(sum / clouds, -0.0005);
-    EXPECT_LT(sum / clouds, 0.0001);
-}
-
-// Readings of a top: `surfaces` sampled four times on jittered 2 mm grids of their own (s, y)
-// coordinates, each reading's height with `sigma` of noise. A surface maps (s, y) to a point.
-template <typename Surface>
-void SampleSurface(const Surface& at, double s_len, double y_half, double sigma, std::mt19937& rng,
-                   std::vector<Eigen::Vector3f>* pts) {
-    std::uniform_real_distribution<double> jitter(0.0, 0.002);
-    std::normal_distribution<double> noise(0.0, sigma);
-    for (int view = 0; view < 4; ++view) {
-        const double js = jitter(rng), jy = jitter(rng);
-        for (double s = js; s < s_len; s += 0.002) {
-            for (double y = -y_half + jy; y < y_half; y += 0.002) {
-                Eigen::Vector3d p = at(s, y);
-                p.z() += noise(rng);
-                pts->push_back(p.cast<float>());
-            }
-        }
-    }
-}
-
-// The mean over 30 clouds of the top's reading less the truth `h`, the clouds drawn by `draw`.
-// The k-th cloud is drawn with k / 30 (a position within a cell, say).
-template <typename Draw>
-double MeanTopError(double h, double sigma, const Draw& draw) {
-    double sum = 0.0;
-    const int clouds = 30;
-    for (int k = 0; k < clouds; ++k) {
-        std::mt19937 rng(static_cast<unsigned>(41 + k));
-        std::vector<Eigen::Vector3f> pts;
-        draw(rng, static_cast<double>(k) / clouds, &pts);
-        double se = 0.0;
-        sum += envelope::TopBound(pts, sigma, 0.2, EnvelopeConfig{}, &se) - h;
-    }
-    return sum / clouds;
+    const double error = MeanTopError(
+        h, sigma,
+        [&](std::mt19937& rng, double, auto* pts) {
+            SampleSurface(
+                [&](double s, double y) -> Eigen::Vector3d {
+                    const double x = -0.1 + s;
+                    return {x, y, h - (x * x + y * y) / (2.0 * radius_of_curvature)};
+                },
+                0.2, 0.1, sigma, rng, pts, 0.004);
+        },
+        0.15, 21);
+    EXPECT_GT(error, -0.0005);
+    EXPECT_LT(error, 0.0001);
 }
 
 TEST(SupportEnvelope, PanelTipIsReadAtItsRidge) {
