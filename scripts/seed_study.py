@@ -23,11 +23,18 @@ SPLIT = re.compile(r"uncertainty: faces ([\d.]+) ([\d.]+) ([\d.]+) mm, registrat
                    r"([\d.]+) mm")
 
 
+def case_angles(case):
+    """The case's own table angles (its --angles), or its poses spread evenly round the table."""
+    extra = case.get("synth", [])
+    if "--angles" in extra:
+        return extra[extra.index("--angles") + 1].split(",")
+    return [round(360.0 * k / case["poses"], 6) for k in range(case["poses"])]
+
+
 def measure(boxd, case, seed, tmp, split):
     out = os.path.join(tmp, f"seed{seed}")
-    angles = [round(360.0 * k / case["poses"], 6) for k in range(case["poses"])]
-    subprocess.run([boxd, *synth_args(dict(case, seed=seed), out, angles)], capture_output=True,
-                   check=True)
+    subprocess.run([boxd, *synth_args(dict(case, seed=seed), out, case_angles(case))],
+                   capture_output=True, check=True)
     env = dict(os.environ, BOXD_LOG_LEVEL="debug") if split else None
     run = subprocess.run([boxd, "measure", "--session", out], capture_output=True, text=True,
                          env=env)
