@@ -2,8 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstdio>
-#include <regex>
 
 #include "daemon/service/sqlite_db.h"
 #include "pipeline/json_text.h"
@@ -17,10 +17,12 @@ namespace {
 
 Error StorageError(const std::string& what) { return Error{ErrorCode::kStorageError, what}; }
 
-// Ids are "m-" and at least six digits; anything else never reaches SQL or the file system.
+// Ids are "m-" and six to twelve digits; anything else never reaches SQL or the file system.
+// A test of the characters, not a function-local regular expression: that is destroyed at exit,
+// while a server thread may still be answering a request that reads it.
 bool IsValidId(const std::string& id) {
-    static const std::regex pattern("m-[0-9]{6,12}");
-    return std::regex_match(id, pattern);
+    if (id.size() < 8 || id.size() > 14 || id.compare(0, 2, "m-") != 0) return false;
+    return std::all_of(id.begin() + 2, id.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
 // Moves `from` to `to` (same file system: an atomic rename; otherwise copy then remove).
