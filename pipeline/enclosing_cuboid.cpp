@@ -109,6 +109,7 @@ Status EnvelopeConfig::Validate() const {
 
 Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result<BoxFit>& box,
                                            int views, double agreement_m, double noise_sigma_m,
+                                           const Eigen::Vector3d& camera_m,
                                            const EnvelopeConfig& config) {
     if (views == 1) {
         return envelope::SingleViewCuboid(cloud, std::max(noise_sigma_m, 0.0005), config);
@@ -116,6 +117,7 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     // The subsample of the surface above the table that the fill, the support function and a
     // grazing top's height all read.
     const envelope::Surface surface = envelope::SurfaceAbove(cloud, config);
+    const double sigma = std::max(noise_sigma_m, 0.0005);
     double face_excess = 0.0;  // the face fit's, when it was tried: a deciding figure either way
     if (box) {
         const BoxFit& fit = *box;
@@ -134,9 +136,12 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
         c.height_m = fit.height_m + faces[4].excess_m;
         double top_se = 0.0;
         if (!fit.top_observed) {
-            // No top face to fit: the height is where the side faces end.
-            c.height_m = envelope::TopBound(surface.points, std::max(noise_sigma_m, 0.0005),
-                                            surface.radius, config, &top_se);
+            // No top face to fit: the height is where the side faces end. No view saw past
+            // their ends, so the top's cells hold walls' ends only, spread up the walls with
+            // their rays' vertical share of the noise (a fifth of the table's at a grazing top).
+            c.height_m = envelope::TopBound(
+                surface.points, sigma, envelope::HeightNoiseSigma(sigma, camera_m, surface.top),
+                surface.radius, config, &top_se);
         }
         // Each side's excess against the box size across it: the sides against the footprint's
         // other dimension... the face's own span is what a bulge is measured against.
@@ -171,7 +176,8 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
         spdlog::debug(
             "envelope: face excess {:.2f} {:.2f} {:.2f} {:.2f} top {:.2f} mm (cell se {:.2f} "
             "{:.2f} "
-            "{:.2f} {:.2f} {:.2f}), plane se {:.2f} {:.2f} {:.2f} {:.2f} {:.2f} mm, fill {:.3f}, top cover {:.3f}",
+            "{:.2f} {:.2f} {:.2f}), plane se {:.2f} {:.2f} {:.2f} {:.2f} {:.2f} mm, fill {:.3f}, "
+            "top cover {:.3f}",
             faces[0].excess_m * 1e3, faces[1].excess_m * 1e3, faces[2].excess_m * 1e3,
             faces[3].excess_m * 1e3, faces[4].excess_m * 1e3, faces[0].excess_se_m * 1e3,
             faces[1].excess_se_m * 1e3, faces[2].excess_se_m * 1e3, faces[3].excess_se_m * 1e3,
@@ -184,7 +190,6 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     // No flat faces at right angles: the support function of the surface.
     // The outer layer of a cell column is the sensor's noise deep: the noise of the table top
     // about its plane, seen at about the object's distance.
-    const double sigma = std::max(noise_sigma_m, 0.0005);
     auto c = envelope::EnvelopeCuboid(surface, sigma, config);
     if (!c) return c;
     c->cuboid = false;

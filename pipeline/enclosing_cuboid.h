@@ -89,9 +89,12 @@ struct EnclosingCuboid {
 // RMSE): faces whose offsets spread between the views by more than a few times that (a tube's
 // side, where each view sees its own tangent) are no flat faces. A face cell counts as standing
 // out by its own statistics (face_envelope.h), not by this figure, which is mostly the noise's.
-// `noise_sigma_m` is the sensor's noise per point (the table top's about its fitted plane).
+// `noise_sigma_m` is the sensor's noise per point (the table top's about its fitted plane), and
+// `camera_m` the camera's position in the table frame, which says how much of that noise a
+// reading's height carries at the object's top (HeightNoiseSigma).
 Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result<BoxFit>& box,
                                            int views, double agreement_m, double noise_sigma_m,
+                                           const Eigen::Vector3d& camera_m,
                                            const EnvelopeConfig& config);
 
 }  // namespace boxd

@@ -121,7 +121,8 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream,
 
     // 7. The smallest enclosing cuboid of the outermost surface, and the shape.
     const auto cuboid = FitEnclosingCuboid(fit.fused, fit.box, n, registered->edges.mean_rmse_m,
-                                           table.residual_sigma_m, config.envelope);
+                                           table.residual_sigma_m,
+                                           table.camera_to_table.translation(), config.envelope);
     m.laps.Lap("fit");
     std::array<double, 3> uncertainty{};
     if (cuboid) {

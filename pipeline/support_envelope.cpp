@@ -235,7 +235,7 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
     auto farther = [&](const Layers& layers, double extent, bool forward, bool walls) {
         double se = 0.0;
         const auto& cells = forward ? layers.front.cells : layers.back.cells;
-        const double bound = LargestBound(cells, config, sigma, extent, &se, &judged, walls);
+        const double bound = LargestBound(cells, config, sigma, sigma, extent, &se, &judged, walls);
         double& best = forward ? out.forward : out.backward;
         if (bound > best) {
             best = bound;
@@ -252,8 +252,8 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
 
 }  // namespace
 
-double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double radius,
-                const EnvelopeConfig& config, double* se) {
+double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double height_sigma,
+                double radius, const EnvelopeConfig& config, double* se) {
     const double cell = 2.0 * config.cell_along_m;
     CellGrid<LayerCell> grid(-radius, radius, -radius, radius, cell, cell);
     std::vector<double> max_z(grid.cells.size(), -INFINITY);
@@ -273,7 +273,7 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double ra
     MarkCapTops(&grid, sigma, config);
     MarkRidgesToReadHigh(&grid, config);
     int judged = 0;
-    return LargestBound(grid.cells, config, sigma, cell, se, &judged);
+    return LargestBound(grid.cells, config, sigma, height_sigma, cell, se, &judged);
 }
 
 Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma,
@@ -338,7 +338,9 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma,
     c.width_m = std::min(lu, lv);
     c.length_axis = lu >= lv ? u : v;
     double se_top = 0.0;
-    c.height_m = TopBound(pts, sigma, radius, config, &se_top);
+    // The top may be a face, a cap or a crest, its walls' ends those of rims beside them: their
+    // heights are read with the noise of a surface facing up.
+    c.height_m = TopBound(pts, sigma, sigma, radius, config, &se_top);
     const double s_u = std::hypot(su.se_forward, su.se_backward);
     const double s_v = std::hypot(sv.se_forward, sv.se_backward);
     c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u, se_top};

@@ -14,9 +14,12 @@
 
 namespace boxd::envelope {
 
-// The height: the top's outer layer over (x, y) cells.
-double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double radius,
-                const EnvelopeConfig& config, double* se);
+// The height: the top's outer layer over (x, y) cells. `sigma` is the noise of a surface facing
+// up (the table top's about its plane); `height_sigma` the noise of a reading's height where the
+// readings spread up a wall's end (HeightNoiseSigma, where no view saw a top and the walls' ends
+// are all there is).
+double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double height_sigma,
+                double radius, const EnvelopeConfig& config, double* se);
 
 // The least-area footprint rectangle of the support function, and the height.
 Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma,

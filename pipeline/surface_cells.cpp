@@ -65,7 +65,8 @@ double HighEndSe(double variance, double spread_variance, int n) {
 double MedianOfLargest(int m) { return UpperNormalQuantile(1.0 - std::pow(0.5, 1.0 / m)); }
 
 double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
-                    double noise_sigma, double cell_extent_m, double* se, int* judged, bool walls) {
+                    double noise_sigma, double wall_noise_sigma, double cell_extent_m, double* se,
+                    int* judged, bool walls) {
     // A cell's outer layer is one of three things; its own 3-D scatter says which.
     //  - A surface facing the direction (its normal within 60 degrees of it): the mean is the
     //    surface. Tilted by θ, it spreads over the cell's extent e by e·tan θ (at most the
@@ -82,13 +83,15 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
     //    a tube's flank: its readings lie on one plane (their variance off
     //    it is the noise's) and spread evenly over the layer, so its high end lies √3 standard
     //    deviations of that spread beyond the noise above their mean, as well as that
-    //    spread's sample variance tells (HighEndSe).
+    //    spread's sample variance tells (HighEndSe). The noise taken off their variance is
+    //    their own along the direction judged (`wall_noise_sigma`), not the facing surface's.
     //  - Two surfaces sharing the cell (a corner: a face and the end of the next one): neither
     //    model holds. The mean is the safe reach, and the uncertainty carries the layer.
     // A variance must exceed the noise's by three of its standard errors to count
     // (SampleVarianceSe).
     const double layer = config.layer_sigmas * noise_sigma;
     const double noise_var = noise_sigma * noise_sigma;
+    const double wall_var = wall_noise_sigma * wall_noise_sigma;
     // A reach, the uncertainty its reading adds to the mean's (`extra_se`), and how far noise
     // alone moves it (`noise_se`: the mean's standard error, and a wall end's high-end reading,
     // HighEndSe, which wanders from cell to cell as the readings fall).
@@ -107,12 +110,14 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
             return {c.Mean() + c.high_end_above_mean_m + c.cap_above_mean_m,
                     std::hypot(se_spread, c.cap_above_mean_m), c.StdError()};
         }
-        if (!walls || var - noise_var <= wander) return {c.Mean(), 0.0, c.StdError()};
+        if (!walls || var - wall_var <= 3.0 * SampleVarianceSe(wall_var, c.n)) {
+            return {c.Mean(), 0.0, c.StdError()};
+        }
         if (off_plane > noise_var + wander) {
             return {c.Mean(), layer / std::sqrt(12.0), c.StdError()};
         }
-        const double high_end_se = HighEndSe(var, var - noise_var, c.n);
-        return {c.Mean() + std::sqrt(3.0 * (var - noise_var)), high_end_se,
+        const double high_end_se = HighEndSe(var, var - wall_var, c.n);
+        return {c.Mean() + std::sqrt(3.0 * (var - wall_var)), high_end_se,
                 std::hypot(c.StdError(), high_end_se)};
     };
     // Each judged cell's reach, once: it costs an eigen-decomposition of the cell's scatter.
@@ -148,6 +153,17 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
         }
     }
     return best;
+}
+
+double HeightNoiseSigma(double table_sigma_m, const Eigen::Vector3d& camera_m, double z_m) {
+    auto vertical_share = [&camera_m](double z) {
+        const Eigen::Vector3d ray = camera_m - Eigen::Vector3d(0.0, 0.0, z);
+        return ray.norm() > 0.0 ? std::abs(ray.z()) / ray.norm() : 1.0;
+    };
+    const double table = vertical_share(0.0);
+    // A camera looking along the table top sees it no better than anything else.
+    if (table < 0.05) return table_sigma_m;
+    return table_sigma_m * std::min(1.0, vertical_share(z_m) / table);
 }
 
 Surface SurfaceAbove(const FusedCloud& cloud, const EnvelopeConfig& config) {

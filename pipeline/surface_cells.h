@@ -92,10 +92,12 @@ double MedianOfLargest(int m);
 // `cell_extent_m` is the cells' larger side; `se` receives the chosen cell's standard error (with
 // a sloped surface's spread), `judged` the number of cells with enough points. Without `walls`
 // every cell reads as a surface facing the direction (its mean), none as a wall's end. Returns
-// -inf when no cell is judged.
+// -inf when no cell is judged. `noise_sigma` is the readings' noise along the direction judged
+// where a surface faces it; `wall_noise_sigma` where the readings spread up a wall's end (it
+// differs where the sensor's rays meet the two at different angles: see TopBound).
 double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
-                    double noise_sigma, double cell_extent_m, double* se, int* judged,
-                    bool walls = true);
+                    double noise_sigma, double wall_noise_sigma, double cell_extent_m, double* se,
+                    int* judged, bool walls = true);
 
 // A dense grid of cells over a rectangle of the (a, b) plane.
 template <typename Cell>
@@ -130,6 +132,14 @@ struct Surface {
 };
 
 Surface SurfaceAbove(const FusedCloud& cloud, const EnvelopeConfig& config);
+
+// Returns the noise of a reading's height at `z_m` above the table's centre, from the noise of
+// the table top about its plane (`table_sigma_m`) and the camera's position (table frame). A
+// depth camera's noise lies along its rays, so a reading's height carries its ray's vertical
+// share of it: the rays to the table fall steeply, those to a tall object's top, seen from
+// nearly level, carry a fraction of their noise in its height (a fifth at a grazing top). The
+// ray noise is taken as the table's (the top is nearer the camera, its noise smaller still).
+double HeightNoiseSigma(double table_sigma_m, const Eigen::Vector3d& camera_m, double z_m);
 
 // Returns how many of `points` (x, y) fall in each square cell of `cell` metres, by cell index.
 std::map<std::pair<int, int>, int> CountFootprintCells(const std::vector<Eigen::Vector2d>& points,

@@ -19,6 +19,7 @@ using test::Block;
 using test::CloudBuilder;
 using test::Fit;
 using test::Fitted;
+using test::kOverhead;
 using test::kSigma;
 using test::kViews;
 using test::kViewShift;
@@ -249,11 +250,12 @@ TEST(FitEnclosingCuboid, ThinCloudIsInsufficientDataWithoutABox) {
         flat.view.push_back(0);
     }
     test::ExpectError(FitEnclosingCuboid(flat, FitFootprintBox(flat.points, BoxFitConfig{}), kViews,
-                                         kShiftAgreement, kSigma, EnvelopeConfig{}),
+                                         kShiftAgreement, kSigma, kOverhead, EnvelopeConfig{}),
                       ErrorCode::kInsufficientData);
-    test::ExpectError(FitEnclosingCuboid(FusedCloud{}, Error{ErrorCode::kObjectTooSmall, "none"},
-                                         kViews, kShiftAgreement, kSigma, EnvelopeConfig{}),
-                      ErrorCode::kInsufficientData);
+    test::ExpectError(
+        FitEnclosingCuboid(FusedCloud{}, Error{ErrorCode::kObjectTooSmall, "none"}, kViews,
+                           kShiftAgreement, kSigma, kOverhead, EnvelopeConfig{}),
+        ErrorCode::kInsufficientData);
 }
 
 TEST(FitEnclosingCuboid, OneViewAssumesACuboidFromTheTopsEdges) {
@@ -277,7 +279,7 @@ TEST(FitEnclosingCuboid, OneViewAssumesACuboidFromTheTopsEdges) {
         for (double z = 0.013; z < h; z += 0.002) put(u, -w / 2 + noise(rng), z);
     }
     const auto c = FitEnclosingCuboid(cloud, FitFootprintBox(cloud.points, BoxFitConfig{}), 1, 0.0,
-                                      kSigma, EnvelopeConfig{});
+                                      kSigma, kOverhead, EnvelopeConfig{});
     ASSERT_TRUE(c.ok()) << c.error().message;
     EXPECT_TRUE(c->assumed);
     EXPECT_TRUE(c->cuboid);
@@ -298,7 +300,7 @@ TEST(FitEnclosingCuboid, OneViewAssumesACuboidFromTheTopsEdges) {
     }
     // (Its highest readings are the wall's upper strip: a vertical surface, not a top.)
     test::ExpectError(FitEnclosingCuboid(side, FitFootprintBox(side.points, BoxFitConfig{}), 1, 0.0,
-                                         kSigma, EnvelopeConfig{}),
+                                         kSigma, kOverhead, EnvelopeConfig{}),
                       ErrorCode::kInsufficientData);
 }
 
