@@ -118,6 +118,13 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     // grazing top's height all read.
     const envelope::Surface surface = envelope::SurfaceAbove(cloud, config);
     const double sigma = std::max(noise_sigma_m, 0.0005);
+    // Where no view saw a top (the box fit found too few readings on one), the top's cells hold
+    // walls' ends only, spread up the walls with their rays' vertical share of the noise (a
+    // fifth of the table's at a grazing top). A top some view saw has rims beside it, read with
+    // the noise of a surface facing up.
+    const double height_sigma = box && !box->top_observed
+                                    ? envelope::HeightNoiseSigma(sigma, camera_m, surface.top)
+                                    : sigma;
     double face_excess = 0.0;  // the face fit's, when it was tried: a deciding figure either way
     if (box) {
         const BoxFit& fit = *box;
@@ -136,12 +143,9 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
         c.height_m = fit.height_m + faces[4].excess_m;
         double top_se = 0.0;
         if (!fit.top_observed) {
-            // No top face to fit: the height is where the side faces end. No view saw past
-            // their ends, so the top's cells hold walls' ends only, spread up the walls with
-            // their rays' vertical share of the noise (a fifth of the table's at a grazing top).
-            c.height_m = envelope::TopBound(
-                surface.points, sigma, envelope::HeightNoiseSigma(sigma, camera_m, surface.top),
-                surface.radius, config, &top_se);
+            // No top face to fit: the height is where the side faces end.
+            c.height_m = envelope::TopBound(surface.points, sigma, height_sigma, surface.radius,
+                                            config, &top_se);
         }
         // Each side's excess against the box size across it: the sides against the footprint's
         // other dimension... the face's own span is what a bulge is measured against.
@@ -190,7 +194,7 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     // No flat faces at right angles: the support function of the surface.
     // The outer layer of a cell column is the sensor's noise deep: the noise of the table top
     // about its plane, seen at about the object's distance.
-    auto c = envelope::EnvelopeCuboid(surface, sigma, config);
+    auto c = envelope::EnvelopeCuboid(surface, sigma, height_sigma, config);
     if (!c) return c;
     c->cuboid = false;
     c->max_relative_excess = face_excess;

@@ -276,7 +276,7 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double he
     return LargestBound(grid.cells, config, sigma, height_sigma, cell, se, &judged);
 }
 
-Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma,
+Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, double height_sigma,
                                        const EnvelopeConfig& config) {
     const std::vector<Eigen::Vector3f>& pts = surface.points;
     if (pts.empty()) return Error{ErrorCode::kInsufficientData, "no surface above the table"};
@@ -338,9 +338,7 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma,
     c.width_m = std::min(lu, lv);
     c.length_axis = lu >= lv ? u : v;
     double se_top = 0.0;
-    // The top may be a face, a cap or a crest, its walls' ends those of rims beside them: their
-    // heights are read with the noise of a surface facing up.
-    c.height_m = TopBound(pts, sigma, sigma, radius, config, &se_top);
+    c.height_m = TopBound(pts, sigma, height_sigma, radius, config, &se_top);
     const double s_u = std::hypot(su.se_forward, su.se_backward);
     const double s_v = std::hypot(sv.se_forward, sv.se_backward);
     c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u, se_top};

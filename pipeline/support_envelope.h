@@ -16,13 +16,13 @@ namespace boxd::envelope {
 
 // The height: the top's outer layer over (x, y) cells. `sigma` is the noise of a surface facing
 // up (the table top's about its plane); `height_sigma` the noise of a reading's height where the
-// readings spread up a wall's end (HeightNoiseSigma, where no view saw a top and the walls' ends
-// are all there is).
+// readings spread up a wall's end (HeightNoiseSigma where no view saw a top).
 double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double height_sigma,
                 double radius, const EnvelopeConfig& config, double* se);
 
-// The least-area footprint rectangle of the support function, and the height.
-Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma,
+// The least-area footprint rectangle of the support function, and the height (`sigma` and
+// `height_sigma` as for TopBound).
+Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, double height_sigma,
                                        const EnvelopeConfig& config);
 
 }  // namespace boxd::envelope
