@@ -111,13 +111,13 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
                                            int views, double agreement_m, double noise_sigma_m,
                                            const Eigen::Vector3d& camera_m,
                                            const EnvelopeConfig& config) {
-    if (views == 1) {
-        return envelope::SingleViewCuboid(cloud, std::max(noise_sigma_m, 0.0005), config);
-    }
+    // The outer layer of a cell column is the sensor's noise deep: the noise of the table top
+    // about its plane, seen at about the object's distance.
+    const double sigma = std::max(noise_sigma_m, 0.0005);
+    if (views == 1) return envelope::SingleViewCuboid(cloud, sigma, config);
     // The subsample of the surface above the table that the fill, the support function and a
     // grazing top's height all read.
     const envelope::Surface surface = envelope::SurfaceAbove(cloud, config);
-    const double sigma = std::max(noise_sigma_m, 0.0005);
     // Where no view saw a top (the box fit found too few readings on one), the top's cells hold
     // walls' ends only, spread up the walls with their rays' vertical share of the noise (a
     // fifth of the table's at a grazing top). A top some view saw has rims beside it, read with
@@ -192,8 +192,6 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
         face_excess = c.max_relative_excess;
     }
     // No flat faces at right angles: the support function of the surface.
-    // The outer layer of a cell column is the sensor's noise deep: the noise of the table top
-    // about its plane, seen at about the object's distance.
     auto c = envelope::EnvelopeCuboid(surface, sigma, height_sigma, config);
     if (!c) return c;
     c->cuboid = false;
