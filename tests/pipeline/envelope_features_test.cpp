@@ -179,27 +179,24 @@ TEST(SupportEnvelope, GrazingWallsEndsAreReadWithTheirOwnHeightNoise) {
     // reading 1 mm off its wall (the noise along a ray that meets the wall nearly level) and a
     // tenth of that in height. The walls' ends spread evenly up to h, over the 5 mm of the top's
     // layer. The table's 1 mm taken for their noise is half their spread's variance: over 30
-    // clouds the top reads -0.83 mm with it, and -0.11 mm with the readings' own tenth of a
+    // clouds the top reads -0.82 mm with it, and -0.11 mm with the readings' own tenth of a
     // millimetre.
     const double h = 0.45, sigma = 0.001, height_sigma = 0.0001, half[2] = {0.10, 0.075};
     auto draw = [&](std::mt19937& rng, double, std::vector<Eigen::Vector3f>* pts) {
-        std::uniform_real_distribution<double> jitter(0.0, 0.002);
-        std::normal_distribution<double> off(0.0, sigma), up(0.0, height_sigma);
-        for (int view = 0; view < 4; ++view) {
-            for (int wall = 0; wall < 4; ++wall) {
-                // Wall `wall` runs along x (0, 1) or y (2, 3), at +half or -half across.
-                const int along = wall < 2 ? 0 : 1, across = 1 - along;
-                const double side = wall % 2 == 0 ? 1.0 : -1.0;
-                const double js = jitter(rng), jz = jitter(rng);
-                for (double s = -half[along] + js; s < half[along]; s += 0.002) {
-                    for (double z = h - 0.04 + jz; z < h; z += 0.002) {
-                        Eigen::Vector3d p(0.0, 0.0, z + up(rng));
-                        p[along] = s;
-                        p[across] = side * (half[across] + off(rng));
-                        pts->push_back(p.cast<float>());
-                    }
-                }
-            }
+        std::normal_distribution<double> off(0.0, sigma);
+        for (int wall = 0; wall < 4; ++wall) {
+            // Wall `wall` runs along x (0, 1) or y (2, 3), at +half or -half across; s goes up
+            // its upper 4 cm.
+            const int along = wall < 2 ? 0 : 1, across = 1 - along;
+            const double side = wall % 2 == 0 ? 1.0 : -1.0;
+            SampleSurface(
+                [&](double s, double y) -> Eigen::Vector3d {
+                    Eigen::Vector3d p(0.0, 0.0, h - 0.04 + s);
+                    p[along] = y;
+                    p[across] = side * (half[across] + off(rng));
+                    return p;
+                },
+                0.04, half[along], height_sigma, rng, pts);
         }
     };
     const double own = MeanTopError(h, sigma, draw, 0.2, 41, height_sigma);
