@@ -71,6 +71,12 @@ Linearization Linearize(const OrientedPoints& source, const IcpTarget& target, c
         const Eigen::Vector3d ns_t(c * ns.x() - sn * ns.y(), sn * ns.x() + c * ns.y(), ns.z());
         if (ns_t.dot(n) < config.min_normal_dot) continue;
         const double r = n.dot((pt - tgt.points[static_cast<std::size_t>(j)]).cast<double>());
+        // A pair's residual is the difference of two centroids, each as uncertain as the noise
+        // over its readings: its inverse variance is the harmonic mean of their readings
+        // (relative to each cloud's mean, so 1 for two ordinary samples). A voxel the surface only
+        // clips counts for the few readings it holds (registration_cloud.h).
+        const double ws = source.Weight(i), wt = tgt.Weight(static_cast<std::size_t>(j));
+        const double readings = ws + wt > 0.0 ? 2.0 * ws * wt / (ws + wt) : 0.0;
         ++lin.matched;
         lin.sq_sum += r * r;
         if (config.point_to_point_weight > 0.0) {
@@ -78,7 +84,7 @@ Linearization Linearize(const OrientedPoints& source, const IcpTarget& target, c
             const Eigen::Vector3f& q = tgt.points[static_cast<std::size_t>(j)];
             const Eigen::Vector2d e(pt.x() - q.x(), pt.y() - q.y());
             const double qe = 1.0 + e.squaredNorm() / k2;
-            const double w = config.point_to_point_weight / (qe * qe);
+            const double w = readings * config.point_to_point_weight / (qe * qe);
             Eigen::Matrix<double, 2, 3> jp;
             jp << 1.0, 0.0, -pt.y(), 0.0, 1.0, pt.x();
             lin.p2p_jtj += w * jp.transpose() * jp;
@@ -87,7 +93,7 @@ Linearization Linearize(const OrientedPoints& source, const IcpTarget& target, c
         if (std::abs(n.z()) > config.max_solve_normal_z) continue;
         // Geman-McClure IRLS weight (Black & Rangarajan 1996): w = 1 / (1 + r²/k²)².
         const double q = 1.0 + r * r / k2;
-        const double w = 1.0 / (q * q);
+        const double w = readings / (q * q);
         const Eigen::Vector3d jac(n.x(), n.y(), n.y() * pt.x() - n.x() * pt.y());
         lin.jtj += w * jac * jac.transpose();
         lin.jtr += w * jac * r;

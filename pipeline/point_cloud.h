@@ -14,6 +14,11 @@ using Points = std::vector<Eigen::Vector3f>;
 struct OrientedPoints {
     Points points;
     Points normals;  // same size as points
+    // Per point, how many readings it stands for, relative to the cloud's mean (a voxel
+    // centroid's share of the view's readings); empty: every point counts once.
+    std::vector<float> weights;
+
+    float Weight(std::size_t i) const { return weights.empty() ? 1.0f : weights[i]; }
 };
 
 // Returns a hash key of the voxel (edge 1/inv_voxel metres) that holds `p`: 21 bits per axis,

@@ -73,9 +73,11 @@ WeightedVoxels VoxelGrid(const Points& points, const std::vector<float>* weights
     return out;
 }
 
-// A cloud regridded, with the voxel edge it was regridded at.
+// A cloud regridded, with the readings each centroid stands for and the voxel edge it was
+// regridded at.
 struct Regridded {
     Points points;
+    std::vector<float> weights;
     double voxel_m = 0.0;
 };
 
@@ -91,7 +93,7 @@ Regridded ReduceVoxels(const WeightedVoxels& base, double base_voxel_m,
         voxel *= std::sqrt(static_cast<double>(v.centroids.size()) / config.max_points);
         v = VoxelGrid(base.centroids, &base.weights, voxel);
     }
-    return {std::move(v.centroids), voxel};
+    return {std::move(v.centroids), std::move(v.weights), voxel};
 }
 
 using Neighbour = NearestGrid::Neighbour;
@@ -197,7 +199,13 @@ OrientedPoints Orient(const Regridded& regridded, const RegistrationCloudConfig&
         if (normal.dot(viewpoint - voxels[i]) < 0.0f) normal = -normal;
         out.points.push_back(voxels[i]);
         out.normals.push_back(normal);
+        out.weights.push_back(regridded.weights[i]);
     }
+    // Relative to the mean, so that an alignment's information keeps the scale of its points.
+    double total = 0.0;
+    for (const float w : out.weights) total += w;
+    const double mean = out.weights.empty() ? 1.0 : total / static_cast<double>(out.weights.size());
+    for (float& w : out.weights) w = static_cast<float>(w / mean);
     return out;
 }
 

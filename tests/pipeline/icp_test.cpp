@@ -61,6 +61,34 @@ TEST(AlignIcp, RecoversKnownPlanarMotionCoarseThenFine) {
     EXPECT_GT(f.information.determinant(), 0.0);
 }
 
+TEST(AlignIcp, WeighsEachPairByTheReadingsOfItsSamples) {
+    // The same view as source and target, and beside each source sample of the +x face another
+    // 2 mm outside it that stands for a hundredth of the readings: the centroid of the few
+    // readings the noise carried into the next voxel. Counted once each, those samples would
+    // pull the face half-way out (a millimetre); counted by their readings, by about 0.04 mm.
+    const RegistrationCloudConfig cloud_cfg;
+    const OrientedPoints view = BuildRegistrationCloud(BoxView(0.0, 5), cloud_cfg, kViewpoint);
+    IcpTarget target(view, 0.01);
+    OrientedPoints source = view;
+    for (std::size_t i = 0; i < view.points.size(); ++i) {
+        if (view.normals[i].x() < 0.9f) continue;
+        source.points.push_back(view.points[i] + Eigen::Vector3f(0.002f, 0.0f, 0.0f));
+        source.normals.push_back(view.normals[i]);
+        source.weights.push_back(0.01f);
+    }
+    ASSERT_GT(source.points.size(), view.points.size() + 100);
+    IcpConfig fine;
+    fine.max_correspondence_m = 0.008;
+    fine.point_to_point_weight = 0.0;
+    const IcpResult weighed = AlignIcp(source, target, Se2{}, fine);
+    EXPECT_NEAR(weighed.transform.x, 0.0, 0.00006);
+    // The same samples counted once each.
+    OrientedPoints counted_once = source;
+    counted_once.weights.clear();
+    const IcpResult once = AlignIcp(counted_once, target, Se2{}, fine);
+    EXPECT_LT(once.transform.x, -0.0005);
+}
+
 TEST(AlignIcp, ReportsNoOverlap) {
     const RegistrationCloudConfig cloud_cfg;
     const Points pts = BoxView(0.0, 3);

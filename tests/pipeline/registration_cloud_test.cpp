@@ -52,6 +52,25 @@ TEST(BuildRegistrationCloud, VoxelCentroidsOfAKnownGrid) {
     EXPECT_NEAR(cloud.points[0].y(), 0.003, 1e-6);
 }
 
+TEST(BuildRegistrationCloud, CentroidsCarryTheReadingsTheyAverage) {
+    // The flat grid, and one more row at x = 0.121: the voxels of [0.120, 0.126) hold a row of
+    // 3 readings instead of 3 x 3, as where a surface only clips a voxel.
+    Points pts = FlatGrid();
+    for (int j = 0; j < 60; ++j) pts.emplace_back(0.121f, 0.001f + 0.002f * j, 0.051f);
+    const OrientedPoints cloud = BuildRegistrationCloud(pts, NoOutlierRemoval(0.006), kAbove);
+    ASSERT_EQ(cloud.points.size(), 420u);
+    ASSERT_EQ(cloud.weights.size(), 420u);
+    double total = 0.0, full = 0.0, clipped = 0.0;
+    for (std::size_t i = 0; i < cloud.points.size(); ++i) {
+        total += cloud.weights[i];
+        (cloud.points[i].x() > 0.12f ? clipped : full) = cloud.weights[i];
+    }
+    // Relative to the cloud's mean, and a third for a third of the readings.
+    EXPECT_NEAR(total / 420.0, 1.0, 1e-6);
+    EXPECT_NEAR(clipped / full, 1.0 / 3.0, 1e-6);
+    EXPECT_NEAR(full, 420.0 / (400.0 + 20.0 / 3.0), 1e-6);
+}
+
 TEST(BuildRegistrationCloud, NormalsOfAPlaneAreThePlaneNormal) {
     // z = 0.05 + 0.3 x: normal along (-0.3, 0, 1). Centroids of coplanar points are coplanar, so
     // only float rounding (~1e-8 m over 6 mm neighbours, ~2e-6 rad) separates the two.
