@@ -4,9 +4,11 @@ with many noise seeds, measures each (`boxd measure`), and prints per dimension 
 and standard deviation against the median 95% bound: a calibrated bound is about 1.96 standard
 deviations of the error, and the median bound about 2.9 times the median |error|. With --split,
 each run's debug log gives the bound's parts (1 sigma, mm): the faces' own and the registration's.
+With --group, every measured case of that group (e.g. box, the ideal boxes) is rendered with the
+seeds, one line per case, and the whole group's count within bound after them.
 
-Usage: scripts/seed_study.py [--boxd build/daemon/boxd] [--case reference] [--seeds 16]
-                             [--first 100] [--split]
+Usage: scripts/seed_study.py [--boxd build/daemon/boxd] [--case reference | --group box]
+                             [--seeds 16] [--first 100] [--split]
 """
 import argparse
 import json
@@ -49,22 +51,14 @@ def measure(boxd, case, seed, tmp, split):
     return seed, err, bound, parts.groups() if parts else ""
 
 
-def main():
-    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--boxd", default=os.path.join(HERE, "..", "build", "daemon", "boxd"))
-    p.add_argument("--case", default="reference")
-    p.add_argument("--seeds", type=int, default=16)
-    p.add_argument("--first", type=int, default=100)
-    p.add_argument("--split", action="store_true")
-    args = p.parse_args()
-    with open(os.path.join(HERE, "..", "tests", "accuracy", "cases.json")) as f:
-        cases = {c["name"]: c for c in json.load(f)["cases"]}
-    if args.case not in cases:
-        raise SystemExit(f"no case '{args.case}' in tests/accuracy/cases.json")
-    case = cases[args.case]
-    seeds = range(args.first, args.first + args.seeds)
+def run_seeds(boxd, case, seeds, split):
+    """Every seed's (seed, errors, bounds, extra) of `case`, two at a time."""
     with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(2) as pool:
-        runs = list(pool.map(lambda s: measure(args.boxd, case, s, tmp, args.split), seeds))
+        return list(pool.map(lambda s: measure(boxd, case, s, tmp, split), seeds))
+
+
+def report_case(runs):
+    """Each run, then per dimension the errors' mean and spread against the median bound."""
     done = [r for r in runs if r[1] is not None]
     for seed, err, bound, extra in runs:
         if err is None:
@@ -84,6 +78,56 @@ def main():
                                            statistics.median(b),
                                            statistics.median(b) / med_e if med_e else float("inf"),
                                            within, len(done)))
+
+
+def report_group(boxd, cases, seeds):
+    """One line per case (the footprint's errors pooled over length and width, the height's), then
+    the group's count within bound, its largest case mean and its largest spread."""
+    within = total = 0
+    worst_mean = worst_sd = 0.0
+    print("%-26s %-17s %-17s %s" % ("case", "L+W mean / sd", "H mean / sd", "within"))
+    for case in cases:
+        done = [r for r in run_seeds(boxd, case, seeds, False) if r[1] is not None]
+        if not done:
+            print("%-26s refused" % case["name"])
+            continue
+        foot = [r[1][i] for r in done for i in (0, 1)]
+        high = [r[1][2] for r in done]
+        inside = sum(abs(e) <= b for r in done for e, b in zip(r[1], r[2]))
+        within += inside
+        total += 3 * len(done)
+        for e in (foot, high):
+            worst_mean = max(worst_mean, abs(statistics.mean(e)))
+            worst_sd = max(worst_sd, statistics.pstdev(e))
+        print("%-26s %+.3f / %.3f mm  %+.3f / %.3f mm  %d of %d" %
+              (case["name"], statistics.mean(foot), statistics.pstdev(foot), statistics.mean(high),
+               statistics.pstdev(high), inside, 3 * len(done)))
+    print("within bound: %d of %d dimensions; largest case mean %.3f mm, largest sd %.3f mm" %
+          (within, total, worst_mean, worst_sd))
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("--boxd", default=os.path.join(HERE, "..", "build", "daemon", "boxd"))
+    p.add_argument("--case", default="reference")
+    p.add_argument("--group", help="every measured case of this group instead of one case")
+    p.add_argument("--seeds", type=int, default=16)
+    p.add_argument("--first", type=int, default=100)
+    p.add_argument("--split", action="store_true")
+    args = p.parse_args()
+    with open(os.path.join(HERE, "..", "tests", "accuracy", "cases.json")) as f:
+        listed = json.load(f)["cases"]
+    seeds = range(args.first, args.first + args.seeds)
+    if args.group:
+        group = [c for c in listed if c.get("group", "box") == args.group and "expect" not in c]
+        if not group:
+            raise SystemExit(f"no measured case in group '{args.group}'")
+        report_group(args.boxd, group, seeds)
+        return
+    cases = {c["name"]: c for c in listed}
+    if args.case not in cases:
+        raise SystemExit(f"no case '{args.case}' in tests/accuracy/cases.json")
+    report_case(run_seeds(args.boxd, cases[args.case], seeds, args.split))
 
 
 if __name__ == "__main__":

@@ -60,15 +60,16 @@ TEST(BuildRegistrationCloud, CentroidsCarryTheReadingsTheyAverage) {
     const OrientedPoints cloud = BuildRegistrationCloud(pts, NoOutlierRemoval(0.006), kAbove);
     ASSERT_EQ(cloud.points.size(), 420u);
     ASSERT_EQ(cloud.weights.size(), 420u);
-    double total = 0.0, full = 0.0, clipped = 0.0;
+    // Relative to the cloud's mean: 9 readings against a mean of 9 x 406.67 / 420, and a third
+    // of that for a third of the readings.
+    const double full = 420.0 / (400.0 + 20.0 / 3.0);
+    double total = 0.0;
     for (std::size_t i = 0; i < cloud.points.size(); ++i) {
+        EXPECT_NEAR(cloud.weights[i], cloud.points[i].x() > 0.12f ? full / 3.0 : full, 1e-6)
+            << cloud.points[i].transpose();
         total += cloud.weights[i];
-        (cloud.points[i].x() > 0.12f ? clipped : full) = cloud.weights[i];
     }
-    // Relative to the cloud's mean, and a third for a third of the readings.
     EXPECT_NEAR(total / 420.0, 1.0, 1e-6);
-    EXPECT_NEAR(clipped / full, 1.0 / 3.0, 1e-6);
-    EXPECT_NEAR(full, 420.0 / (400.0 + 20.0 / 3.0), 1e-6);
 }
 
 TEST(BuildRegistrationCloud, NormalsOfAPlaneAreThePlaneNormal) {
