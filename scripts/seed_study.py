@@ -5,10 +5,11 @@ and standard deviation against the median 95% bound: a calibrated bound is about
 deviations of the error, and the median bound about 2.9 times the median |error|. With --split,
 each run's debug log gives the bound's parts (1 sigma, mm): the faces' own and the registration's.
 With --group, every measured case of that group (e.g. box, the ideal boxes) is rendered with the
-seeds, one line per case, and the whole group's count within bound after them.
+seeds, one line per case, and the whole group's count within bound after them. --synth adds
+`boxd synth` options to every rendering (e.g. a station without errors, or another depth unit).
 
 Usage: scripts/seed_study.py [--boxd build/daemon/boxd] [--case reference | --group box]
-                             [--seeds 16] [--first 100] [--split]
+                             [--seeds 16] [--first 100] [--split] [--synth="--depth-unit-m 0.0001"]
 """
 import argparse
 import json
@@ -114,10 +115,13 @@ def main():
     p.add_argument("--seeds", type=int, default=16)
     p.add_argument("--first", type=int, default=100)
     p.add_argument("--split", action="store_true")
+    p.add_argument("--synth", default="", help="extra `boxd synth` options for every rendering")
     args = p.parse_args()
     with open(os.path.join(HERE, "..", "tests", "accuracy", "cases.json")) as f:
         listed = json.load(f)["cases"]
     seeds = range(args.first, args.first + args.seeds)
+    if args.synth:
+        listed = [dict(c, synth=c.get("synth", []) + args.synth.split()) for c in listed]
     if args.group:
         group = [c for c in listed if c.get("group", "box") == args.group and "expect" not in c]
         if not group:

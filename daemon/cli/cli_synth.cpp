@@ -15,8 +15,8 @@
 #include "daemon/cli/cli.h"
 #include "drivers/sim/synthetic_objects.h"
 #include "drivers/sim/synthetic_station.h"
-#include "pipeline/session_io.h"
 #include "pipeline/json_text.h"
+#include "pipeline/session_io.h"
 
 namespace boxd::cli {
 
@@ -37,6 +37,7 @@ struct SynthOptions {
     std::optional<double> distance_m, elevation_deg, aim_height_m;
     std::optional<double> angle_error_deg, calib_center_error_m, calib_axis_error_deg;
     std::optional<double> depth_offset_m, calib_depth_offset_error_m, focal_error_pct;
+    std::optional<double> depth_unit_m;
     std::optional<int> move_at_pose;
     std::vector<double> move_by;
     std::vector<double> angles;
@@ -48,6 +49,10 @@ struct SynthOptions {
     std::optional<int> intruder_pose;
     bool force = false;
 };
+
+// The units a frame may be recorded in: 16 bits of 0.01 mm reach 0.65 m, of 10 mm 655 m.
+constexpr double kMinDepthUnitM = 0.00001;
+constexpr double kMaxDepthUnitM = 0.01;
 
 // Returns the frame files a previous synthetic session in `dir` listed, or an error if `dir`
 // holds anything else (so that user data is never overwritten without --force).
@@ -156,6 +161,14 @@ Result<SyntheticStationConfig> MakeConfig(const SynthOptions& o) {
     if (o.depth_offset_m) c.true_depth_offset_m = *o.depth_offset_m;
     if (o.calib_depth_offset_error_m) c.calib_depth_offset_error_m = *o.calib_depth_offset_error_m;
     if (o.focal_error_pct) c.focal_error_pct = *o.focal_error_pct;
+    if (o.depth_unit_m) {
+        // 16-bit frames: a 0.1 mm unit still reaches 6.5 m, past any depth camera's range here.
+        if (!(*o.depth_unit_m >= kMinDepthUnitM && *o.depth_unit_m <= kMaxDepthUnitM)) {
+            return Error{ErrorCode::kInvalidInput,
+                         "--depth-unit-m: must be between 0.00001 and 0.01 m"};
+        }
+        c.camera.depth_unit_m = *o.depth_unit_m;
+    }
     if (o.move_at_pose) {
         c.moved_at_pose = *o.move_at_pose;
         if (!o.move_by.empty()) {
@@ -240,6 +253,9 @@ void AddSynth(CLI::App& app, Runner& run) {
     sub->add_option("--focal-error-pct", o->focal_error_pct,
                     "The camera's true focal length is this many per cent longer than the "
                     "session's fx, fy (the recorded calibration keeps focal_scale 1)");
+    sub->add_option("--depth-unit-m", o->depth_unit_m,
+                    "Unit of the recorded frames (m): 0.001 (default) or 0.0001, as the "
+                    "camera's depth_mode 1mm or 100um records");
     sub->add_option("--move-at-pose", o->move_at_pose, "The box is moved from this pose on");
     sub->add_option("--move-by", o->move_by, "The move: DX DY (m) DYAW (deg)")->expected(3);
     sub->add_option("--angles", o->angles,
