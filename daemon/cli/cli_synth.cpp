@@ -254,8 +254,8 @@ void AddSynth(CLI::App& app, Runner& run) {
                     "The camera's true focal length is this many per cent longer than the "
                     "session's fx, fy (the recorded calibration keeps focal_scale 1)");
     sub->add_option("--depth-unit-m", o->depth_unit_m,
-                    "Unit of the recorded frames (m): 0.001 (default) or 0.0001, as the "
-                    "camera's depth_mode 1mm or 100um records");
+                    "Unit of the recorded frames (m), 0.00001 to 0.01: 0.001 (the default) "
+                    "or 0.0001 as the camera's depth_mode 1mm or 100um records");
     sub->add_option("--move-at-pose", o->move_at_pose, "The box is moved from this pose on");
     sub->add_option("--move-by", o->move_by, "The move: DX DY (m) DYAW (deg)")->expected(3);
     sub->add_option("--angles", o->angles,

@@ -97,7 +97,7 @@ TEST(CliSynth, RecordsFramesInTheDepthUnitAsked) {
     EXPECT_DOUBLE_EQ(mm->camera.depth_unit_m, 0.001);
     EXPECT_DOUBLE_EQ(um->camera.depth_unit_m, 0.0001);
     // The same scene: each reading's depth agrees to within half a millimetre (the coarser
-    // unit's rounding), and the finer unit keeps the tenths a millimetre drops.
+    // unit's rounding), and the finer unit keeps the tenths of a millimetre that 1 mm drops.
     const auto& a = mm->poses[0].frames[0].pixels;
     const auto& b = um->poses[0].frames[0].pixels;
     ASSERT_EQ(a.size(), b.size());
