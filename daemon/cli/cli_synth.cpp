@@ -50,7 +50,8 @@ struct SynthOptions {
     bool force = false;
 };
 
-// The units a frame may be recorded in: 16 bits of 0.01 mm reach 0.65 m, of 10 mm 655 m.
+// The units a frame may be recorded in: 16 bits of 0.01 mm reach 0.65 m, of 0.1 mm 6.5 m (past
+// any depth camera's range here), of 10 mm 655 m.
 constexpr double kMinDepthUnitM = 0.00001;
 constexpr double kMaxDepthUnitM = 0.01;
 
@@ -162,7 +163,6 @@ Result<SyntheticStationConfig> MakeConfig(const SynthOptions& o) {
     if (o.calib_depth_offset_error_m) c.calib_depth_offset_error_m = *o.calib_depth_offset_error_m;
     if (o.focal_error_pct) c.focal_error_pct = *o.focal_error_pct;
     if (o.depth_unit_m) {
-        // 16-bit frames: a 0.1 mm unit still reaches 6.5 m, past any depth camera's range here.
         if (!(*o.depth_unit_m >= kMinDepthUnitM && *o.depth_unit_m <= kMaxDepthUnitM)) {
             return Error{ErrorCode::kInvalidInput,
                          "--depth-unit-m: must be between 0.00001 and 0.01 m"};
