@@ -5,6 +5,7 @@
 #include <unordered_set>
 #include <vector>
 
+#include "pipeline/bowed_face.h"
 #include "pipeline/surface_cells.h"
 
 namespace boxd::envelope {
@@ -88,6 +89,19 @@ struct FaceCells {
                               ? offsets.StdError()
                               : spread / std::sqrt(std::max<std::size_t>(1, cells.size()));
         ReadExcess(judged, config, out.view_spread_m, &out);
+        // A panel bowing out smoothly shows as a whole face (bowed_face.h).
+        std::vector<FaceCell> face;
+        face.reserve(judged.size());
+        for (const Judged& c : judged) {
+            const auto col = static_cast<double>(c.key % static_cast<std::size_t>(na));
+            const auto row = static_cast<double>(c.key / static_cast<std::size_t>(na));
+            face.push_back({col, row, c.st.Mean(), c.se});
+        }
+        const auto bow = BowedFaceReach(face, config.false_alarm, out.view_spread_m);
+        if (bow && bow->excess_m > out.excess_m) {
+            out.excess_m = bow->excess_m;
+            out.excess_se_m = bow->se_m;
+        }
         return out;
     }
 
