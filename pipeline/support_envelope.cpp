@@ -1,6 +1,7 @@
 #include "pipeline/support_envelope.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <utility>
 
@@ -250,6 +251,55 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
     return out;
 }
 
+// The rectangles no worse than the least one by more than their noise, their sides averaged,
+// where the least one has no direction of its own. The least area over many directions is the
+// least of that many noisy areas: where the object's rectangle hardly changes with its
+// direction (a standing tube, a round bag), it is the direction whose supports the noise made
+// smallest, and a tube's diameter read half a millimetre small. Where the object has a
+// direction (a box, an L), the area grows away from it by the sum of its sides squared per
+// radian, so the rectangles alike lie within 2 sigma_A / (lu² + lv²) of it, a step either way
+// at most; those are wider by the other side times the turn, which a noisy area may not show,
+// and the least rectangle stands alone.
+struct Alike {
+    int orientations = 1;
+    double along_u = 0.0, along_v = 0.0;  // mean sides along the least rectangle's u and v
+};
+
+Alike AlikeRectangles(const std::vector<Support>& supports, int best) {
+    const int n = static_cast<int>(supports.size());
+    auto sides = [&](int i) {
+        const Support &a = supports[static_cast<std::size_t>(i % n)],
+                      &b = supports[static_cast<std::size_t>((i + n / 2) % n)];
+        return std::array<double, 4>{a.forward + a.backward, b.forward + b.backward,
+                                     std::hypot(a.se_forward, a.se_backward),
+                                     std::hypot(b.se_forward, b.se_backward)};
+    };
+    auto area = [](const std::array<double, 4>& s) { return s[0] * s[1]; };
+    auto area_se = [](const std::array<double, 4>& s) {
+        return std::hypot(s[1] * s[2], s[0] * s[3]);
+    };
+    const auto least = sides(best);
+    const double step = M_PI / n;
+    const double faceted = 2.0 * area_se(least) / (least[0] * least[0] + least[1] * least[1]);
+    double sum_u = 0.0, sum_v = 0.0, widest = 0.0;
+    int count = 0;
+    for (int i = 0; i < n / 2; ++i) {
+        const auto s = sides(i);
+        if (area(s) - area(least) > 2.0 * std::hypot(area_se(s), area_se(least))) continue;
+        // Sides paired with the least rectangle's: i's first side lies along u when i is within
+        // a quarter turn of it.
+        const int turn = ((i - best) % n + n) % n;
+        const bool same = turn < n / 4 || turn >= 3 * n / 4;
+        const int off = turn % (n / 2);
+        widest = std::max(widest, step * std::min(off, n / 2 - off));
+        sum_u += same ? s[0] : s[1];
+        sum_v += same ? s[1] : s[0];
+        ++count;
+    }
+    if (widest <= faceted + step) return {};
+    return {count, sum_u / count, sum_v / count};
+}
+
 }  // namespace
 
 double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double height_sigma,
@@ -315,7 +365,8 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
     }
     double best_phi = M_PI * best / n, best_area = w[best] * w[(best + n / 2) % n];
     Support su = coarse[best], sv = coarse[(best + n / 2) % n];
-    for (int j = -9; j <= 9; ++j) {
+    const auto alike = AlikeRectangles(coarse, best);
+    for (int j = -9; j <= 9 && alike.orientations == 1; ++j) {
         const double phi = M_PI * best / n + j * (M_PI / n) / 10.0;
         Support a, b;
         const double area = width(phi, &a) * width(phi + M_PI / 2.0, &b);
@@ -332,7 +383,8 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
     }
     EnclosingCuboid c;
     const Eigen::Vector2d u(std::cos(best_phi), std::sin(best_phi)), v(-u.y(), u.x());
-    const double lu = su.forward + su.backward, lv = sv.forward + sv.backward;
+    const double lu = alike.orientations > 1 ? alike.along_u : su.forward + su.backward;
+    const double lv = alike.orientations > 1 ? alike.along_v : sv.forward + sv.backward;
     c.center_m = 0.5 * (su.forward - su.backward) * u + 0.5 * (sv.forward - sv.backward) * v;
     c.length_m = std::max(lu, lv);
     c.width_m = std::min(lu, lv);

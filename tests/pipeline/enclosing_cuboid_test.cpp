@@ -131,6 +131,22 @@ TEST(FitEnclosingCuboid, StandingTubeIsIrregularAndBoundedByItsDiameter) {
     EXPECT_LT(c.fill, EnvelopeConfig{}.min_fill);
 }
 
+TEST(FitEnclosingCuboid, StandingTubesDiameterIsNotTheLeastOfItsNoisyWidths) {
+    // Every direction's rectangle around a tube is the same up to the noise: the least of them
+    // is the one the noise made smallest. Over seeds the diameter must come out unbiased.
+    const double r = 0.08, h = 0.30;
+    double sum = 0.0;
+    const int seeds = 6;
+    for (int seed = 1; seed <= seeds; ++seed) {
+        const Fitted f = Fit(SampleCylinder(r, h, {0.01, 0.02}, static_cast<unsigned>(seed)));
+        ASSERT_TRUE(f.cuboid.ok()) << f.cuboid.error().message;
+        sum += f.cuboid->length_m + f.cuboid->width_m - 4.0 * r;
+    }
+    // The least rectangle's sides read 0.59 mm small on average over these seeds; the alike
+    // rectangles' mean +0.10 mm.
+    EXPECT_NEAR(sum / (2.0 * seeds), 0.0, 0.0002);
+}
+
 TEST(FitEnclosingCuboid, LShapeIsIrregularAndBoundedByItsBoundingBox) {
     // 0.4 x 0.3 without its (+x, +y) 0.2 x 0.15 quarter: two blocks side by side.
     const double l = 0.40, w = 0.30, h = 0.20;
