@@ -20,7 +20,8 @@ constexpr int kMinFlatnessCells = 10;
 // its sensor's disparity steps, so its points are not).
 struct FaceCells {
     int views = 1;
-    int na = 1;  // cells across the face's grid: a cell's key is row * na + column
+    int na = 1;                 // cells across the face's grid: a cell's key is row * na + column
+    double da = 1.0, db = 1.0;  // the cells' size across and up the face
     std::unordered_map<std::size_t, CellStats> cell_view;  // key cell * views + view
     std::vector<CellStats> view_plane;                     // per view: offsets near the plane
 
@@ -95,7 +96,7 @@ struct FaceCells {
         for (const Judged& c : judged) {
             const auto col = static_cast<double>(c.key % static_cast<std::size_t>(na));
             const auto row = static_cast<double>(c.key / static_cast<std::size_t>(na));
-            face.push_back({col, row, c.st.Mean(), c.se});
+            face.push_back({col * da, row * db, c.st.Mean(), c.se});
         }
         const auto bow = BowedFaceReach(face, config.false_alarm, out.view_spread_m);
         if (bow && bow->excess_m > out.excess_m) {
@@ -182,7 +183,11 @@ std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& b
         f.views = nv;
         f.view_plane.resize(static_cast<std::size_t>(nv));
     }
-    for (std::size_t f = 0; f < 5; ++f) faces[f].na = grids[f].na;
+    for (std::size_t f = 0; f < 5; ++f) {
+        faces[f].na = grids[f].na;
+        faces[f].da = grids[f].da;
+        faces[f].db = grids[f].db;
+    }
     for (std::size_t i = 0; i < cloud.points.size(); ++i) {
         const Eigen::Vector3f& p3 = cloud.points[i];
         const Eigen::Vector2d q = p3.head<2>().cast<double>() - box.center_m;
