@@ -1,5 +1,6 @@
 // Known-answer tests of a face's smooth crest (pipeline/bowed_face.h) on hand-made cell grids:
-// a panel bowing out, a flat face, a tilted one, one whose edges roll away, and too few cells.
+// a panel bowing out, a flat face, a tilted one, one whose edges roll away, a patch the fit does
+// not follow, too few cells and a crest under the views' disagreement.
 #include "pipeline/bowed_face.h"
 
 #include <gtest/gtest.h>
@@ -7,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -32,6 +34,12 @@ std::vector<FaceCell> Cells(int na, int nb, const std::function<double(double, d
     return cells;
 }
 
+// BowedFaceReach of Cells(na, nb, shape, seed) against `threshold_m`.
+std::optional<BowedReach> Read(int na, int nb, const std::function<double(double, double)>& shape,
+                               unsigned seed, double threshold_m = 0.0) {
+    return BowedFaceReach(Cells(na, nb, shape, seed), kFalseAlarm, threshold_m);
+}
+
 // A panel held at its edges and pushed out by `crest` in the middle, its offsets taken from
 // its mean plane (which lies (2/3)² of the crest above the edges).
 double Panel(double x, double y, double crest) {
@@ -44,28 +52,25 @@ TEST(BowedFace, ReadsTheCrestOfAPanelBowingOut) {
     const double crest = 0.0015, above_plane = crest * (1.0 - 4.0 / 9.0);
     int read = 0;
     for (unsigned seed = 1; seed <= 40; ++seed) {
-        const auto reach = BowedFaceReach(
-            Cells(
-                20, 15, [&](double x, double y) { return Panel(x, y, crest); }, seed),
-            kFalseAlarm, 0.0);
+        const auto reach = Read(
+            20, 15, [&](double x, double y) { return Panel(x, y, crest); }, seed);
         if (!reach) continue;
         ++read;
         EXPECT_GT(reach->se_m, 0.0);
-        // The quadratic about the crest leaves out the panel's x²y² term: a hundredth of the
-        // crest at most over its window.
+        // The tensor-product fit holds the panel's shape exactly, so the level is the crest's
+        // cells' within their noise (with a hundredth of the crest to spare).
         EXPECT_NEAR(reach->excess_m, above_plane, 3.0 * reach->se_m + crest / 100.0) << seed;
     }
-    // The crest's cells and the quadratic disagree by chance at the false-alarm rate.
+    // The crest's cells and the fit disagree by chance at the false-alarm rate.
     EXPECT_GE(read, 35);
 }
 
 TEST(BowedFace, FlatFaceRarelyBowsOut) {
     int bowed = 0;
     for (unsigned seed = 1; seed <= 200; ++seed) {
-        const auto reach = BowedFaceReach(Cells(
-                                              20, 15, [](double, double) { return 0.0; }, seed),
-                                          kFalseAlarm, 0.0);
-        bowed += reach ? 1 : 0;
+        if (Read(
+                20, 15, [](double, double) { return 0.0; }, seed))
+            ++bowed;
     }
     // Each of the F test, the crest inside the face and its lower bound passes a flat face
     // with the false-alarm rate at most.
@@ -74,11 +79,9 @@ TEST(BowedFace, FlatFaceRarelyBowsOut) {
 
 TEST(BowedFace, TiltedFaceCrestsAtItsEdge) {
     for (unsigned seed = 1; seed <= 10; ++seed) {
-        const auto reach = BowedFaceReach(
-            Cells(
-                20, 15, [](double x, double y) { return 0.002 * x + 0.001 * y; }, seed),
-            kFalseAlarm, 0.0);
-        EXPECT_FALSE(reach.has_value()) << seed;
+        EXPECT_FALSE(Read(
+            20, 15, [](double x, double y) { return 0.002 * x + 0.001 * y; }, seed))
+            << seed;
     }
 }
 
@@ -91,10 +94,8 @@ TEST(BowedFace, FlatMiddleOfRolledEdgesIsNotReadAsACrest) {
         return -0.002 * r * r;
     };
     for (unsigned seed = 1; seed <= 20; ++seed) {
-        const auto reach =
-            BowedFaceReach(Cells(
-                               20, 15, [&](double x, double y) { return roll(x) + roll(y); }, seed),
-                           kFalseAlarm, 0.0);
+        const auto reach = Read(
+            20, 15, [&](double x, double y) { return roll(x) + roll(y); }, seed);
         if (reach) {
             EXPECT_LE(reach->excess_m, 3.0 * reach->se_m) << seed;
         }
@@ -123,20 +124,14 @@ TEST(BowedFace, PatchTheFitDoesNotFollowIsNoCrest) {
 }
 
 TEST(BowedFace, TooFewCellsReadNothing) {
-    const auto reach =
-        BowedFaceReach(Cells(
-                           4, 5, [](double x, double y) { return Panel(x, y, 0.005); }, 1),
-                       kFalseAlarm, 0.0);
-    EXPECT_FALSE(reach.has_value());
+    EXPECT_FALSE(Read(
+        4, 5, [](double x, double y) { return Panel(x, y, 0.005); }, 1));
 }
 
 TEST(BowedFace, CrestBelowTheViewsDisagreementIsNoBow) {
     // The views disagree about the plane by 2 mm: a crest under that is not the object's.
-    const auto reach =
-        BowedFaceReach(Cells(
-                           20, 15, [](double x, double y) { return Panel(x, y, 0.0015); }, 1),
-                       kFalseAlarm, 0.002);
-    EXPECT_FALSE(reach.has_value());
+    EXPECT_FALSE(Read(
+        20, 15, [](double x, double y) { return Panel(x, y, 0.0015); }, 1, 0.002));
 }
 
 }  // namespace
