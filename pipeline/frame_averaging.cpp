@@ -1,9 +1,14 @@
 #include "pipeline/frame_averaging.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <optional>
+
+#include "pipeline/depth_levels.h"
 
 namespace boxd {
 
@@ -20,8 +25,20 @@ struct AveragingPass {
     std::vector<const std::uint16_t*> src;  // the frames' pixel arrays
     std::size_t required = 1;               // valid readings a pixel needs
     std::vector<std::uint32_t> window;      // agreement window (raw units) by median reading
+    // Each recorded value's depth in 1/kFixedScale raw units (the value times kFixedScale when
+    // the readings come in no levels), so that sums stay integer and vectorise.
+    std::vector<std::int32_t> fixed;
     double unit = 0.001;
 };
+
+// 8 bits below the raw unit: 8 frames of 16-bit values still sum within 31 bits, and a level's
+// depth is kept to 1/256 of the unit (4 microns for 1 mm).
+constexpr double kFixedScale = 256.0;
+
+float FixedMean(std::uint64_t sum, std::uint64_t kept, double unit) {
+    return static_cast<float>(static_cast<double>(sum) * (unit / kFixedScale) /
+                              static_cast<double>(kept));
+}
 
 // Averages the pass's N frames into *out, pixel by pixel (a refused pixel stays 0). The rule:
 // the lower median of the valid readings, then the mean of those within the median's agreement
@@ -70,7 +87,7 @@ void AverageAll(const AveragingPass& pass, DepthMap* out) {
                 const std::int32_t v = pass.src[f][start + p];
                 const std::int32_t d = v > med ? v - med : med - v;
                 const bool agrees = v != 0 && d <= window;
-                sum += agrees ? v : 0;
+                sum += agrees ? pass.fixed[static_cast<std::size_t>(v)] : 0;
                 kept += agrees ? 1 : 0;
             }
             sums[p] = static_cast<std::uint32_t>(sum);
@@ -81,8 +98,7 @@ void AverageAll(const AveragingPass& pass, DepthMap* out) {
             // an edge or a moving surface).
             const std::uint32_t kept = agreeing[p];
             if (valid[p] < pass.required || kept < pass.required || 2 * kept <= valid[p]) continue;
-            out->z_m[start + p] = static_cast<float>(static_cast<double>(sums[p]) * pass.unit /
-                                                     static_cast<double>(kept));
+            out->z_m[start + p] = FixedMean(sums[p], kept, pass.unit);
         }
     }
 }
@@ -104,12 +120,12 @@ void AveragePixelAnyCount(const AveragingPass& pass, std::size_t i, std::uint16_
     for (std::size_t j = 0; j < k; ++j) {
         const std::uint32_t v = r[j];
         if ((v > median ? v - median : median - v) <= tol) {
-            sum += v;
+            sum += static_cast<std::uint64_t>(pass.fixed[v]);
             ++kept;
         }
     }
     if (kept < pass.required || 2 * kept <= k) return;
-    *out = static_cast<float>(static_cast<double>(sum) * pass.unit / static_cast<double>(kept));
+    *out = FixedMean(sum, kept, pass.unit);
 }
 
 }  // namespace
@@ -149,6 +165,20 @@ Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, doubl
         1, static_cast<std::size_t>(std::ceil(config.min_valid_fraction * n - 1e-9)));
     pass.unit = depth_unit_m;
     for (const DepthImage& f : frames) pass.src.push_back(f.pixels.data());
+    // The recorded values' depths: their levels' where the readings come in levels
+    // (depth_levels.h).
+    const auto levels = config.depth_levels ? FindDepthLevels(frames, depth_unit_m) : std::nullopt;
+    if (levels) {
+        spdlog::debug("depth levels: {:.9f} per m apart, {} values fitted, {:.2f}% on a level",
+                      levels->spacing_per_m, levels->fitted, 100.0 * levels->on_level);
+    } else {
+        spdlog::debug("depth levels: none (the recorded values are the depths)");
+    }
+    const std::vector<double> depth = RecordedValueDepths(levels, depth_unit_m);
+    pass.fixed.resize(depth.size());
+    for (std::size_t v = 0; v < depth.size(); ++v) {
+        pass.fixed[v] = static_cast<std::int32_t>(std::lround(depth[v] / depth_unit_m * kFixedScale));
+    }
     // The agreement window of SPEC section 7's sensor model grows with depth: looked up per raw
     // median reading (in raw units) instead of computed in metres for every pixel.
     pass.window.resize(65537);  // the last entry: a pixel without readings (never used)

@@ -16,6 +16,9 @@ struct AveragingConfig {
     // the z^2 term follows the quadratic growth of structured-light depth noise.
     double agreement_abs_m = 0.006;
     double agreement_rel_per_m = 0.01;
+    // Read each recorded value as the depth of the sensor's level it was rounded from, when the
+    // readings come in levels (depth_levels.h).
+    bool depth_levels = true;
 
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;
