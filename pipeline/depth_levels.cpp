@@ -9,6 +9,7 @@ namespace boxd {
 namespace {
 
 constexpr std::size_t kValues = 65536;
+constexpr std::size_t kEnoughReadings = 300000;
 // Where levels lie at least this many units apart, each has a recorded value of its own and the
 // values between them stay empty: the test of the readings against the levels has its power
 // there. Below one unit apart, several levels round to one value, which keeps its own depth.
@@ -149,9 +150,14 @@ double NearestLevelDepth(const DepthLevels& levels, double u) {
 std::optional<DepthLevels> FindDepthLevels(const std::vector<DepthImage>& frames,
                                            double depth_unit_m) {
     if (!(depth_unit_m > 0.0)) return std::nullopt;
-    std::vector<std::uint64_t> counts(kValues, 0);
+    // A few hundred thousand readings show every level many times over: with more frames, a
+    // stride through each. Four bytes a count keep the histogram in the cache.
+    std::size_t readings = 0;
+    for (const DepthImage& f : frames) readings += f.pixels.size();
+    const std::size_t stride = std::max<std::size_t>(1, readings / kEnoughReadings);
+    std::vector<std::uint32_t> counts(kValues, 0);
     for (const DepthImage& f : frames) {
-        for (const std::uint16_t v : f.pixels) ++counts[v];
+        for (std::size_t i = 0; i < f.pixels.size(); i += stride) ++counts[f.pixels[i]];
     }
     std::vector<Recorded> all;  // by increasing depth
     for (std::size_t v = 1; v < kValues; ++v) {
@@ -220,24 +226,19 @@ std::optional<DepthLevels> FindDepthLevels(const std::vector<DepthImage>& frames
     }
     levels.on_level = total > 0 ? static_cast<double>(on) / static_cast<double>(total) : 0.0;
     if (levels.on_level < kMinOnLevel) return std::nullopt;
+    levels.lowest = all.front().value;
+    levels.highest = all.back().value;
     return levels;
 }
 
-std::vector<double> RecordedValueDepths(const std::optional<DepthLevels>& levels,
-                                        double depth_unit_m) {
-    std::vector<double> depth(kValues);
-    for (std::size_t v = 0; v < kValues; ++v) {
-        const double z = static_cast<double>(v) * depth_unit_m;
-        depth[v] = z;
-        if (!levels || v == 0) continue;
-        const double u = 1.0 / z;
-        if (SpacingUnits(levels->spacing_per_m, u, depth_unit_m) < kUniqueUnits) continue;
-        const double level = NearestLevelDepth(*levels, u);
-        if (std::abs(level / depth_unit_m - static_cast<double>(v)) <= 0.5 + kSlackUnits) {
-            depth[v] = level;
-        }
-    }
-    return depth;
+double RecordedDepth(const DepthLevels& levels, int value, double depth_unit_m) {
+    const double z = static_cast<double>(value) * depth_unit_m;
+    if (value <= 0) return z;
+    const double u = 1.0 / z;
+    if (SpacingUnits(levels.spacing_per_m, u, depth_unit_m) < kUniqueUnits) return z;
+    const double level = NearestLevelDepth(levels, u);
+    return std::abs(level / depth_unit_m - static_cast<double>(value)) <= 0.5 + kSlackUnits ? level
+                                                                                            : z;
 }
 
 }  // namespace boxd

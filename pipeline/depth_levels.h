@@ -32,6 +32,7 @@ struct DepthLevels {
     double spacing_per_m = 0.0;  // the levels' spacing in 1/z
     int fitted = 0;              // recorded values the fit went through
     double on_level = 0.0;  // share of the readings where levels are sparse that round from one
+    int lowest = 0, highest = 0;  // the recorded values the readings span
 };
 
 // Returns the levels the readings of `frames` (in units of `depth_unit_m`, 0 = none) come in, or
@@ -39,10 +40,8 @@ struct DepthLevels {
 std::optional<DepthLevels> FindDepthLevels(const std::vector<DepthImage>& frames,
                                            double depth_unit_m);
 
-// Returns the depth in metres of every 16-bit recorded value: the depth of the level `levels`
-// says rounds to it, or the value times `depth_unit_m` where no single level does (or there are
-// no levels).
-std::vector<double> RecordedValueDepths(const std::optional<DepthLevels>& levels,
-                                        double depth_unit_m);
+// Returns the depth in metres of recorded value `value`: the depth of the level of `levels` that
+// rounds to it, or the value times `depth_unit_m` where no single level does.
+double RecordedDepth(const DepthLevels& levels, int value, double depth_unit_m);
 
 }  // namespace boxd

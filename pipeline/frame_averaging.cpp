@@ -25,15 +25,17 @@ struct AveragingPass {
     std::vector<const std::uint16_t*> src;  // the frames' pixel arrays
     std::size_t required = 1;               // valid readings a pixel needs
     std::vector<std::uint32_t> window;      // agreement window (raw units) by median reading
-    // Each recorded value's depth in 1/kFixedScale raw units (the value times kFixedScale when
-    // the readings come in no levels), so that sums stay integer and vectorise.
+    // When the readings come in levels, each recorded value's depth in 1/kFixedScale raw units,
+    // so that sums stay integer (without levels, a value's depth is itself times kFixedScale).
+    bool levels = false;
     std::vector<std::int32_t> fixed;
     double unit = 0.001;
 };
 
 // 8 bits below the raw unit: 8 frames of 16-bit values still sum within 31 bits, and a level's
 // depth is kept to 1/256 of the unit (4 microns for 1 mm).
-constexpr double kFixedScale = 256.0;
+constexpr std::int32_t kFixedBits = 8;
+constexpr double kFixedScale = 1 << kFixedBits;
 
 float FixedMean(std::uint64_t sum, std::uint64_t kept, double unit) {
     return static_cast<float>(static_cast<double>(sum) * (unit / kFixedScale) /
@@ -47,7 +49,9 @@ float FixedMean(std::uint64_t sum, std::uint64_t kept, double unit) {
 // them would be mispredicted about half the time), so the median loop vectorises. A reading
 // of 0 (no return) ranks above every valid one: the lower median of the k valid readings is
 // the one with (k - 1) / 2 readings before it (ties broken by frame order).
-template <std::size_t N>
+// kLevels: the readings are read at their levels (pass.fixed), which the compiler cannot gather
+// as fast as it shifts the values themselves.
+template <std::size_t N, bool kLevels>
 void AverageAll(const AveragingPass& pass, DepthMap* out) {
     constexpr std::size_t kBlock = 1024;
     constexpr std::int32_t kNone = 0x10000;  // above every 16-bit reading
@@ -87,7 +91,9 @@ void AverageAll(const AveragingPass& pass, DepthMap* out) {
                 const std::int32_t v = pass.src[f][start + p];
                 const std::int32_t d = v > med ? v - med : med - v;
                 const bool agrees = v != 0 && d <= window;
-                sum += agrees ? pass.fixed[static_cast<std::size_t>(v)] : 0;
+                const std::int32_t depth =
+                    kLevels ? pass.fixed[static_cast<std::size_t>(v)] : v << kFixedBits;
+                sum += agrees ? depth : 0;
                 kept += agrees ? 1 : 0;
             }
             sums[p] = static_cast<std::uint32_t>(sum);
@@ -100,6 +106,15 @@ void AverageAll(const AveragingPass& pass, DepthMap* out) {
             if (valid[p] < pass.required || kept < pass.required || 2 * kept <= valid[p]) continue;
             out->z_m[start + p] = FixedMean(sums[p], kept, pass.unit);
         }
+    }
+}
+
+template <std::size_t N>
+void AverageWith(const AveragingPass& pass, DepthMap* out) {
+    if (pass.levels) {
+        AverageAll<N, true>(pass, out);
+    } else {
+        AverageAll<N, false>(pass, out);
     }
 }
 
@@ -120,7 +135,8 @@ void AveragePixelAnyCount(const AveragingPass& pass, std::size_t i, std::uint16_
     for (std::size_t j = 0; j < k; ++j) {
         const std::uint32_t v = r[j];
         if ((v > median ? v - median : median - v) <= tol) {
-            sum += static_cast<std::uint64_t>(pass.fixed[v]);
+            sum += pass.levels ? static_cast<std::uint64_t>(pass.fixed[v])
+                               : static_cast<std::uint64_t>(v) << kFixedBits;
             ++kept;
         }
     }
@@ -174,10 +190,16 @@ Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, doubl
     } else {
         spdlog::debug("depth levels: none (the recorded values are the depths)");
     }
-    const std::vector<double> depth = RecordedValueDepths(levels, depth_unit_m);
-    pass.fixed.resize(depth.size());
-    for (std::size_t v = 0; v < depth.size(); ++v) {
-        pass.fixed[v] = static_cast<std::int32_t>(std::lround(depth[v] / depth_unit_m * kFixedScale));
+    pass.levels = levels.has_value();
+    if (levels) {
+        pass.fixed.resize(65536);
+        for (std::size_t v = 0; v < pass.fixed.size(); ++v) {
+            pass.fixed[v] = static_cast<std::int32_t>(v) << kFixedBits;
+        }
+        for (int v = levels->lowest; v <= levels->highest; ++v) {
+            pass.fixed[static_cast<std::size_t>(v)] = static_cast<std::int32_t>(
+                std::lround(RecordedDepth(*levels, v, depth_unit_m) / depth_unit_m * kFixedScale));
+        }
     }
     // The agreement window of SPEC section 7's sensor model grows with depth: looked up per raw
     // median reading (in raw units) instead of computed in metres for every pixel.
@@ -190,14 +212,14 @@ Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, doubl
     }
     DepthMap out(w, h);
     switch (n) {
-        case 1: AverageAll<1>(pass, &out); break;
-        case 2: AverageAll<2>(pass, &out); break;
-        case 3: AverageAll<3>(pass, &out); break;
-        case 4: AverageAll<4>(pass, &out); break;
-        case 5: AverageAll<5>(pass, &out); break;
-        case 6: AverageAll<6>(pass, &out); break;
-        case 7: AverageAll<7>(pass, &out); break;
-        case 8: AverageAll<8>(pass, &out); break;
+        case 1: AverageWith<1>(pass, &out); break;
+        case 2: AverageWith<2>(pass, &out); break;
+        case 3: AverageWith<3>(pass, &out); break;
+        case 4: AverageWith<4>(pass, &out); break;
+        case 5: AverageWith<5>(pass, &out); break;
+        case 6: AverageWith<6>(pass, &out); break;
+        case 7: AverageWith<7>(pass, &out); break;
+        case 8: AverageWith<8>(pass, &out); break;
         default: {
             std::vector<std::uint16_t> r(n);
             for (std::size_t i = 0; i < out.z_m.size(); ++i) {

@@ -44,16 +44,18 @@ std::vector<DepthImage> Scene(const Sensor* sensor, double near_m, double far_m,
     return out;
 }
 
-// The largest distance (m) between a recorded value's depth and the level it was rounded from,
-// over the values in [near_m, far_m] where `sensor`'s levels are 1.2 units apart or more.
-double WorstLevelError(const std::vector<double>& depth, const Sensor& sensor, double near_m,
-                       double far_m, double unit_m) {
+// The largest distance (m) between a recorded value's depth (`depth` of the value) and the
+// level it was rounded from, over the values in [near_m, far_m] where `sensor`'s levels are 1.2
+// units apart or more.
+template <typename Depth>
+double WorstLevelError(const Depth& depth, const Sensor& sensor, double near_m, double far_m,
+                       double unit_m) {
     double worst = 0.0;
     for (double z = near_m; z < far_m; z = 1.0 / (1.0 / z - sensor.spacing_per_m)) {
         const double level = sensor.Level(z);
         if (sensor.spacing_per_m * level * level < 1.2 * unit_m) continue;
-        const auto v = static_cast<std::size_t>(std::lround(level / unit_m));
-        worst = std::max(worst, std::abs(depth[v] - level));
+        worst =
+            std::max(worst, std::abs(depth(static_cast<int>(std::lround(level / unit_m))) - level));
     }
     return worst;
 }
@@ -63,19 +65,23 @@ TEST(FindDepthLevels, FindsTheKinectsLevelsAndReadsEachValueAtItsLevel) {
     ASSERT_TRUE(levels.has_value());
     EXPECT_NEAR(levels->spacing_per_m / kKinect.spacing_per_m, 1.0, 1e-4);
     EXPECT_GE(levels->on_level, 0.999);
-    const auto depth = RecordedValueDepths(levels, 0.001);
+    const auto depth = [&](int v) { return RecordedDepth(*levels, v, 0.001); };
     EXPECT_LT(WorstLevelError(depth, kKinect, 0.6, 2.5, 0.001), 1e-5);
-    // Without levels every value is its own depth.
-    const auto plain = RecordedValueDepths(std::nullopt, 0.001);
-    EXPECT_DOUBLE_EQ(plain[1234], 1.234);
+    // Read as recorded, values are up to half a unit off their levels.
+    const auto plain = [](int v) { return v * 0.001; };
     EXPECT_GT(WorstLevelError(plain, kKinect, 0.6, 2.5, 0.001), 4e-4);
+    // The levels end where the readings do; nearer than 0.61 m they lie less than 1.15 units
+    // apart, and a value there keeps its own depth.
+    EXPECT_LE(levels->lowest, 600);
+    EXPECT_GE(levels->highest, 2500);
+    EXPECT_DOUBLE_EQ(depth(600), 0.6);
 }
 
 TEST(FindDepthLevels, FindsAStereoCamerasSubpixelLevelsInAFinerUnit) {
     const auto levels = FindDepthLevels(Scene(&kStereo, 0.8, 3.0, 0.003, 0.0001), 0.0001);
     ASSERT_TRUE(levels.has_value());
     EXPECT_NEAR(levels->spacing_per_m / kStereo.spacing_per_m, 1.0, 1e-5);
-    const auto depth = RecordedValueDepths(levels, 0.0001);
+    const auto depth = [&](int v) { return RecordedDepth(*levels, v, 0.0001); };
     EXPECT_LT(WorstLevelError(depth, kStereo, 0.8, 3.0, 0.0001), 1e-5);
 }
 
