@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
+#include "drivers/sim/synthetic_station.h"
 #include "pipeline/frame_averaging.h"
 
 namespace boxd {
@@ -157,6 +159,41 @@ TEST(AverageDepthFrames, ReadsTheLevelsAndSoLosesTheirRoundingToTheUnit) {
     };
     EXPECT_NEAR(surface(true), worst_z, 2e-5);
     EXPECT_NEAR(surface(false), worst_z + worst_bias, 2e-5);
+}
+
+// The synthetic station's Kinect-class pose recorded in 1 mm and in 0.1 mm units (the same
+// noise draws, each level rounded to either unit): read at their levels, both average to the
+// same depths; read as recorded, the millimetres are off by the rounding left after averaging.
+TEST(AverageDepthFrames, AKinectPoseInMillimetresAveragesAsInTenthsOfAMillimetre) {
+    auto mean_difference = [](bool levels) {
+        std::vector<DepthMap> maps;
+        for (const double unit : {0.001, 0.0001}) {
+            SyntheticStationConfig c;
+            c.noise = NoiseModel::kKinect;
+            c.camera.depth_unit_m = unit;
+            c.seed = 9;
+            const auto session = RenderSyntheticSession(c, 1, 4);
+            EXPECT_TRUE(session.ok());
+            AveragingConfig config;
+            config.depth_levels = levels;
+            maps.push_back(*AverageDepthFrames(session->poses[0].frames, unit, config));
+        }
+        double sum = 0.0;
+        int n = 0;
+        for (std::size_t i = 0; i < maps[0].z_m.size(); ++i) {
+            if (maps[0].z_m[i] > 0.0f && maps[1].z_m[i] > 0.0f) {
+                sum += std::abs(maps[0].z_m[i] - maps[1].z_m[i]);
+                ++n;
+            }
+        }
+        EXPECT_GT(n, 100000);
+        return sum / n;
+    };
+    const double at_levels = mean_difference(true), as_recorded = mean_difference(false);
+    std::printf("1 mm against 0.1 mm, mean per pixel: %.4f mm at the levels, %.4f mm as recorded\n",
+                at_levels * 1e3, as_recorded * 1e3);
+    EXPECT_LT(at_levels, 1e-5);
+    EXPECT_GT(as_recorded, 1e-4);
 }
 
 }  // namespace
