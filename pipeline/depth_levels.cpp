@@ -107,8 +107,9 @@ std::pair<double, double> FeasibleLevels(const std::vector<Assigned>& values, do
     return {high - low, 0.5 * (low + high)};
 }
 
-// Refines the line of FitLine: the least squares place the levels only to about a tenth of the
-// rounding over the square root of their number, but every value says within which range its
+// Refines the line of FitLine: the least squares place the levels only to about a third of a
+// unit (the rounding's spread, 1/√12) over the square root of their number, microns too many
+// for a level a hair from half a unit off its value; but every value says within which range its
 // level lies, and the lines that meet all of them form a narrow convex set. Its width in a is
 // concave in the spacing: a ternary search finds a spacing inside the set, bisections its two
 // ends, and the line is the middle of the set at the middle spacing. Unchanged when no line
