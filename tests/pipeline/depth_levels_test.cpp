@@ -116,6 +116,26 @@ TEST(FindDepthLevels, AFewReadingsOffTheLevelsAreToleratedManyAreNot) {
     }
 }
 
+// Whatever the readings, the search ends, and levels it does return read every value within half
+// a unit and a slack of it.
+TEST(FindDepthLevels, AnyReadingsEndInLevelsThatHoldOrNone) {
+    std::mt19937 rng(17);
+    for (int trial = 0; trial < 40; ++trial) {
+        std::uniform_int_distribution<int> lo(1, 60000), span(0, 5000), every(1, 7);
+        const int first = lo(rng), last = std::min(65535, first + span(rng)), gap = every(rng);
+        std::uniform_int_distribution<int> value(first, last);
+        std::vector<DepthImage> frames(2, DepthImage(64, 48));
+        for (DepthImage& f : frames) {
+            for (auto& p : f.pixels) p = static_cast<std::uint16_t>(value(rng) / gap * gap);
+        }
+        const auto levels = FindDepthLevels(frames, 0.001);
+        if (!levels) continue;
+        for (int v = levels->lowest; v <= levels->highest; ++v) {
+            EXPECT_NEAR(RecordedDepth(*levels, v, 0.001), v * 0.001, 0.00056) << v;
+        }
+    }
+}
+
 // A flat surface at the depth where the rounding of the Kinect's levels to millimetres biases
 // the mean reading most: averaged over many pixels and frames, the levels' depths give the
 // surface's depth; the recorded values are off by the rounding the noise does not average out.
