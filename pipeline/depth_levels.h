@@ -13,12 +13,14 @@
 // Nothing about the sensor is assumed but the even spacing in 1/z. Where the levels lie more
 // than a unit apart, consecutive recorded values are consecutive levels: their median spacing
 // starts the fit, and a least-squares line through the values' 1/z against their level index,
-// over windows that double, places the levels to microns. The levels are accepted only when
+// over windows that double, places the levels to a fraction of a unit; the middle of the narrow
+// set of lines that put every value's level inside its rounding interval places them to
+// microns (a level a hair from half a unit off its value must be read at the right one). The
+// levels are accepted only when
 // nearly every reading there rounds from one, so readings that are continuous (a stereo camera
 // recorded finely, an ideal sensor) keep their recorded values. Each recorded value that one
 // level rounds to is then read as that level's depth.
 
-#include <cstdint>
 #include <optional>
 #include <vector>
 
