@@ -36,6 +36,7 @@ struct AveragingPass {
 // depth is kept to 1/256 of the unit (4 microns for 1 mm).
 constexpr std::int32_t kFixedBits = 8;
 constexpr double kFixedScale = 1 << kFixedBits;
+constexpr std::size_t kValues = 65536;  // every 16-bit reading
 
 float FixedMean(std::uint64_t sum, std::uint64_t kept, double unit) {
     return static_cast<float>(static_cast<double>(sum) * (unit / kFixedScale) /
@@ -109,6 +110,7 @@ void AverageAll(const AveragingPass& pass, DepthMap* out) {
     }
 }
 
+// AverageAll for the pass's kind of readings.
 template <std::size_t N>
 void AverageWith(const AveragingPass& pass, DepthMap* out) {
     if (pass.levels) {
@@ -192,7 +194,7 @@ Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, doubl
     }
     pass.levels = levels.has_value();
     if (levels) {
-        pass.fixed.resize(65536);
+        pass.fixed.resize(kValues);
         for (std::size_t v = 0; v < pass.fixed.size(); ++v) {
             pass.fixed[v] = static_cast<std::int32_t>(v) << kFixedBits;
         }
@@ -203,7 +205,7 @@ Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, doubl
     }
     // The agreement window of SPEC section 7's sensor model grows with depth: looked up per raw
     // median reading (in raw units) instead of computed in metres for every pixel.
-    pass.window.resize(65537);  // the last entry: a pixel without readings (never used)
+    pass.window.resize(kValues + 1);  // the last entry: a pixel without readings (never used)
     for (std::size_t v = 0; v < pass.window.size(); ++v) {
         const double z = static_cast<double>(v) * depth_unit_m;
         const double tol = config.agreement_abs_m + config.agreement_rel_per_m * z * z;
