@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "pipeline/key_index.h"
+#include "pipeline/median.h"
 #include "pipeline/parallel_for.h"
 
 namespace boxd {
@@ -16,13 +17,6 @@ namespace {
 
 Status Bad(const std::string& field, const std::string& why) {
     return Error{ErrorCode::kInvalidConfig, "box_fit." + field + ": " + why};
-}
-
-double Median(std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    auto mid = v.begin() + static_cast<long>(v.size() / 2);
-    std::nth_element(v.begin(), mid, v.end());
-    return *mid;
 }
 
 // 1.4826 * the median absolute deviation from `center`: the standard deviation of normally

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <utility>
 
+#include "pipeline/median.h"
+
 namespace boxd {
 
 namespace {
@@ -47,14 +49,6 @@ struct Recorded {
 // The levels' spacing in units at `u`: dz = du / u^2.
 double SpacingUnits(double spacing_per_m, double u, double unit) {
     return spacing_per_m / (u * u * unit);
-}
-
-// Returns the median of `v` (reordered), 0 when empty.
-double Median(std::vector<double>* v) {
-    if (v->empty()) return 0.0;
-    const auto mid = v->begin() + static_cast<std::ptrdiff_t>(v->size() / 2);
-    std::nth_element(v->begin(), mid, v->end());
-    return *mid;
 }
 
 // A recorded value given a level: the level's index and the range of 1/z that rounds to it.
@@ -173,7 +167,7 @@ std::optional<DepthLevels> FindDepthLevels(const std::vector<DepthImage>& frames
     // split their pair); every reading is tested against them.
     std::vector<double> seen;
     for (const Recorded& r : all) seen.push_back(static_cast<double>(r.count));
-    const double often = std::max(2.0, Median(&seen) * kOftenShare);
+    const double often = std::max(2.0, Median(std::move(seen)) * kOftenShare);
     std::vector<Recorded> values;
     for (const Recorded& r : all) {
         if (static_cast<double>(r.count) >= often) values.push_back(r);
@@ -190,7 +184,7 @@ std::optional<DepthLevels> FindDepthLevels(const std::vector<DepthImage>& frames
                                    : values[i + 1].value - values[i].value >= 2;
             if (apart) gaps.push_back(du);
         }
-        return gaps.size() >= kMinPairs ? Median(&gaps) : 0.0;
+        return gaps.size() >= kMinPairs ? Median(gaps) : 0.0;
     };
     double spacing = pair_gaps(0.0, 0.0);
     if (spacing > 0.0) spacing = pair_gaps(kStartUnits, spacing);

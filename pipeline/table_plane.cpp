@@ -3,6 +3,9 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <utility>
+
+#include "pipeline/median.h"
 
 namespace boxd {
 
@@ -14,10 +17,7 @@ Status Bad(const std::string& field, const std::string& why) {
 
 // Robust sigma from the median absolute deviation (1.4826 * MAD for a normal distribution).
 double RobustSigma(std::vector<double> abs_residuals) {
-    if (abs_residuals.empty()) return 0.0;
-    auto mid = abs_residuals.begin() + static_cast<long>(abs_residuals.size() / 2);
-    std::nth_element(abs_residuals.begin(), mid, abs_residuals.end());
-    return 1.4826 * *mid;
+    return 1.4826 * Median(std::move(abs_residuals));
 }
 
 struct Plane {
