@@ -194,6 +194,8 @@ Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, doubl
     }
     pass.levels = levels.has_value();
     if (levels) {
+        // Every value keeps its own depth, but for those of the span the levels were found in
+        // (a value the histogram's stride passed over may lie outside it).
         pass.fixed.resize(kValues);
         for (std::size_t v = 0; v < pass.fixed.size(); ++v) {
             pass.fixed[v] = static_cast<std::int32_t>(v) << kFixedBits;

@@ -21,6 +21,8 @@ constexpr double kUnseenShare = 0.25;
 struct Support {
     double forward = -INFINITY, backward = -INFINITY;
     double se_forward = 0.0, se_backward = 0.0;
+    double Width() const { return forward + backward; }
+    double WidthSe() const { return std::hypot(se_forward, se_backward); }
 };
 
 // A sloped patch of an outer layer (the top's: an opened panel, a tube's shoulder; a side's: the
@@ -270,9 +272,7 @@ Alike AlikeRectangles(const std::vector<Support>& supports, int best) {
     auto sides = [&](int i) {
         const Support &a = supports[static_cast<std::size_t>(i % n)],
                       &b = supports[static_cast<std::size_t>((i + n / 2) % n)];
-        return std::array<double, 4>{a.forward + a.backward, b.forward + b.backward,
-                                     std::hypot(a.se_forward, a.se_backward),
-                                     std::hypot(b.se_forward, b.se_backward)};
+        return std::array<double, 4>{a.Width(), b.Width(), a.WidthSe(), b.WidthSe()};
     };
     auto area = [](const std::array<double, 4>& s) { return s[0] * s[1]; };
     auto area_se = [](const std::array<double, 4>& s) {
@@ -346,7 +346,7 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
         }
         const double slack = kUnseenShare * (reach_f + reach_b);
         if (s->forward < reach_f - slack || s->backward < reach_b - slack) return INFINITY;
-        return s->forward + s->backward;
+        return s->Width();
     };
     // Every direction, then finer about the least area.
     const int n = config.directions;
@@ -383,16 +383,16 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
     }
     EnclosingCuboid c;
     const Eigen::Vector2d u(std::cos(best_phi), std::sin(best_phi)), v(-u.y(), u.x());
-    const double lu = alike.orientations > 1 ? alike.along_u : su.forward + su.backward;
-    const double lv = alike.orientations > 1 ? alike.along_v : sv.forward + sv.backward;
+    const double lu = alike.orientations > 1 ? alike.along_u : su.Width();
+    const double lv = alike.orientations > 1 ? alike.along_v : sv.Width();
     c.center_m = 0.5 * (su.forward - su.backward) * u + 0.5 * (sv.forward - sv.backward) * v;
     c.length_m = std::max(lu, lv);
     c.width_m = std::min(lu, lv);
     c.length_axis = lu >= lv ? u : v;
     double se_top = 0.0;
     c.height_m = TopBound(pts, sigma, height_sigma, radius, config, &se_top);
-    const double s_u = std::hypot(su.se_forward, su.se_backward);
-    const double s_v = std::hypot(sv.se_forward, sv.se_backward);
+    const double s_u = su.WidthSe();
+    const double s_v = sv.WidthSe();
     c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u, se_top};
     return c;
 }
