@@ -30,7 +30,10 @@ T NormalizeAngle(const T& a) {
 //     D = P ∘ M⁻¹:   δθ = wrap(θ_P − θ_m),   δt = t_P − R(δθ) t_m,
 // which is zero exactly when P = M, and the residual is r = U (δt, δθ) with UᵀU the edge's
 // information (PoseEdge::information, same left-perturbation coordinates), so that
-// |r|² = eᵀ Λ e, the Mahalanobis distance of the edge.
+// |r|² = eᵀ Λ e, the Mahalanobis distance of the edge. U is upper triangular: r₂ is the yaw's
+// error alone, r₁ the translation's along y less what the yaw explains, r₀ along x less what
+// both explain. Every view is in the table frame of the station, whose x is the camera's x
+// laid on the table (station_calibration.h): y runs along the camera's line of sight.
 class RelativeCost {
 public:
     RelativeCost(const Se2& measured, const Eigen::Matrix3d& sqrt_information)
@@ -127,7 +130,9 @@ void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Problem
             e.loop_closure ? new ceres::HuberLoss(config.loop_huber_scale) : nullptr;
         const Eigen::Matrix3d info =
             e.point_scatter / (config.edge_displacement_sigma_m * config.edge_displacement_sigma_m);
-        p.problem->AddResidualBlock(RelativeCost::Create(e.measured, SqrtInformation(info)), loss,
+        Eigen::Matrix3d sqrt_info = SqrtInformation(info);
+        for (int row = 0; row < 3; ++row) sqrt_info.row(row) /= config.edge_part_scale[row];
+        p.problem->AddResidualBlock(RelativeCost::Create(e.measured, sqrt_info), loss,
                                     p.params[static_cast<std::size_t>(e.from)].data(),
                                     p.params[static_cast<std::size_t>(e.to)].data());
     }
@@ -185,6 +190,9 @@ Status PoseGraphConfig::Validate() const {
     if (!(prior_yaw_sigma_rad > 0.0)) return bad("prior_yaw_sigma_rad", "must be > 0");
     if (!(prior_center_sigma_m > 0.0)) return bad("prior_center_sigma_m", "must be > 0");
     if (!(edge_displacement_sigma_m > 0.0)) return bad("edge_displacement_sigma_m", "must be > 0");
+    for (double scale : edge_part_scale) {
+        if (!(scale > 0.0 && std::isfinite(scale))) return bad("edge_part_scale", "must be > 0");
+    }
     if (!(loop_huber_scale > 0.0)) return bad("loop_huber_scale", "must be > 0");
     if (!(max_edge_displacement_m > 0.0)) return bad("max_edge_displacement_m", "must be > 0");
     if (max_rejection_rounds < 0) return bad("max_rejection_rounds", "must be >= 0");

@@ -3,6 +3,7 @@
 // examples/slam: plain structs, one cost functor per constraint kind, build and solve separate.
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "pipeline/result.h"
@@ -19,6 +20,12 @@ struct PoseGraphConfig {
     // Edges are weighted by their surface displacement (IcpResult::point_scatter) over this
     // sigma: ICP errors are correlated across points, so JᵀJ / sigma² would be overconfident.
     double edge_displacement_sigma_m = 0.001;
+    // ... and each of an edge's three residual rows by this factor more: the translation across
+    // the camera's line of sight (x of the table frame), along it (y) less what the yaw
+    // explains, and the yaw (RelativeCost in pose_graph.cpp). The camera measures along and
+    // across its line of sight with different errors, and ICP turns with others again. The
+    // variance components set them (variance_rounds); 1 weighs the three as the sigma says.
+    std::array<double, 3> edge_part_scale = {1.0, 1.0, 1.0};
     double loop_huber_scale = 2.0;  // Huber loss on loop closures, in edge sigmas
     // An edge whose solved residual moves its surfaces by more than this (RMS along the normals)
     // is rejected and the graph re-solved. Directions the edge's data do not constrain (sliding
@@ -72,10 +79,11 @@ Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfi
 
 // Returns the covariance of the solved poses, 3N x 3N in (x, y, yaw) per node (node 0 defines
 // the frame: its rows are zero). The inverse of JᵀJ of the whitened residuals at the solution,
-// with the ICP edges and the turntable prior each weighted by its variance component estimated
-// from its own residuals (Förstner): the configured sigmas only weigh the solve, the scatter
-// the solution shows decides how well the poses are known. Without redundancy (no edges: the
-// turntable model alone) the prior's configured sigmas, per node.
+// with the ICP edges' three rows and the turntable prior's translations and yaws each weighted
+// by its variance component estimated from its own residuals (Förstner): the configured sigmas
+// only weigh the solve, the scatter the solution shows decides how well the poses are known.
+// Without redundancy (no edges: the turntable model alone) the prior's configured sigmas, per
+// node.
 Eigen::MatrixXd PoseCovariance(const PoseGraph& graph, const PoseGraphConfig& config);
 
 // Returns the residual (x, y, yaw) of `edge` at the graph's current poses.

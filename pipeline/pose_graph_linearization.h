@@ -24,8 +24,8 @@ struct Linearization {
 // Returns the linearisation at the graph's poses, or nothing when Ceres cannot evaluate it.
 std::optional<Linearization> Linearize(const PoseGraph& graph, const PoseGraphConfig& config);
 
-// Re-solves with each group of residuals (the ICP edges, the prior's translations, its yaws)
-// weighed by its variance component at the solution (pose_graph_variance.cpp), for
+// Re-solves with each group of residuals (the ICP edges' three rows, the prior's translations,
+// its yaws) weighed by its variance component at the solution (pose_graph_variance.cpp), for
 // config.variance_rounds rounds. The configured sigmas are guesses that hold for no station in
 // particular: edges weighed as if good to a millimetre against a table good to half a degree
 // make the solution a compromise between them, and the compromise leaks into the one direction

@@ -12,17 +12,19 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 
 // A ring of n turntable poses about an axis that sits `center` away from the calibrated one,
-// with true angle errors; edges are exact relative motions plus small noise.
+// with true angle errors; edges are exact relative motions plus small noise (`along_sigma_m`,
+// when given, along y, the camera's line of sight, instead of `edge_sigma_m`).
 struct Ring {
     std::vector<Se2> truth;
     PoseGraph graph;
 };
 
 Ring MakeRing(int n, Eigen::Vector2d center, unsigned seed, double edge_sigma_m = 0.0002,
-              double angle_error_deg = 0.3) {
+              double angle_error_deg = 0.3, double along_sigma_m = 0.0) {
     std::mt19937 rng(seed);
     std::normal_distribution<double> angle_err(0.0, angle_error_deg * kDeg),
         t_noise(0.0, edge_sigma_m),
+        along_noise(0.0, along_sigma_m > 0.0 ? along_sigma_m : edge_sigma_m),
         yaw_noise(0.0, 0.02 * kDeg);
     Ring ring;
     for (int k = 0; k < n; ++k) {
@@ -40,7 +42,8 @@ Ring MakeRing(int n, Eigen::Vector2d center, unsigned seed, double edge_sigma_m 
             e.to = j;
             const Se2 rel = ring.truth[static_cast<std::size_t>(i)].Inverse().Compose(
                 ring.truth[static_cast<std::size_t>(j)]);
-            e.measured = Se2{t_noise(rng), t_noise(rng), yaw_noise(rng)}.Compose(rel);
+            const double across = t_noise(rng), along = along_noise(rng);
+            e.measured = Se2{across, along, yaw_noise(rng)}.Compose(rel);
             e.information = Eigen::Vector3d(1.0 / 4e-8, 1.0 / 4e-8, 1.0 / 1.2e-7).asDiagonal();
             // Surfaces about 0.2 m from the axis: a yaw error moves them 0.2 m per radian.
             e.point_scatter = Eigen::Vector3d(0.5, 0.5, 0.04).asDiagonal();
@@ -181,6 +184,65 @@ TEST(PoseCovariance, IsWithinAFactorOfTheTrueScatter) {
     const double ratio = std::sqrt(predicted / squared_error);
     EXPECT_GT(ratio, 0.5);
     EXPECT_LT(ratio, 2.0);
+}
+
+// The covariance of view j's pose relative to view i's, in view i's frame (the camera's: x
+// across its line of sight, y along it), from the poses' covariance by a numeric Jacobian.
+Eigen::Matrix3d RelativeCovariance(const PoseGraph& graph, const Eigen::MatrixXd& cov, int i,
+                                   int j) {
+    const auto relative = [&](const Se2& a, const Se2& b) {
+        const Se2 rel = graph.poses[static_cast<std::size_t>(i)].Inverse().Compose(
+            graph.poses[static_cast<std::size_t>(j)]);
+        return Se2Difference(a.Inverse().Compose(b), rel);
+    };
+    Eigen::Matrix<double, 3, 6> jac;
+    const double h = 1e-7;
+    for (int c = 0; c < 6; ++c) {
+        Se2 a = graph.poses[static_cast<std::size_t>(i)],
+            b = graph.poses[static_cast<std::size_t>(j)];
+        Se2& moved = c < 3 ? a : b;
+        (c % 3 == 0 ? moved.x : c % 3 == 1 ? moved.y : moved.yaw) += h;
+        jac.col(c) = relative(a, b) / h;
+    }
+    Eigen::Matrix<double, 6, 6> sub;
+    const Eigen::Index at[2] = {3 * i, 3 * j};
+    for (int r = 0; r < 2; ++r) {
+        for (int c = 0; c < 2; ++c) sub.block<3, 3>(3 * r, 3 * c) = cov.block<3, 3>(at[r], at[c]);
+    }
+    return jac * sub * jac.transpose();
+}
+
+TEST(PoseCovariance, EachPartOfTheEdgesIsKnownByItsOwnScatter) {
+    // Edges five times noisier along the camera's line of sight (y) than across it (x), as a
+    // depth camera's are: how well one view sits across the line of sight from its neighbour is
+    // known by the edges' scatter across it, not widened by their scatter along it.
+    PoseGraphConfig config;
+    double predicted[2] = {}, squared_error[2] = {};
+    for (unsigned seed = 10; seed < 40; ++seed) {
+        Ring ring = MakeRing(12, {0.0, 0.0}, seed, 0.0001, 0.3, 0.0005);
+        ASSERT_TRUE(OptimizePoseGraph(ring.graph, config).ok());
+        const Eigen::MatrixXd cov = PoseCovariance(ring.graph, config);
+        for (int i = 0; i < 12; ++i) {
+            const int j = (i + 1) % 12;
+            const auto& p = ring.graph.poses;
+            const auto& t = ring.truth;
+            const Eigen::Vector3d d = Se2Difference(
+                p[static_cast<std::size_t>(i)].Inverse().Compose(p[static_cast<std::size_t>(j)]),
+                t[static_cast<std::size_t>(i)].Inverse().Compose(t[static_cast<std::size_t>(j)]));
+            const Eigen::Matrix3d rc = RelativeCovariance(ring.graph, cov, i, j);
+            for (int a = 0; a < 2; ++a) {
+                squared_error[a] += d(a) * d(a);
+                predicted[a] += rc(a, a);
+            }
+        }
+    }
+    for (int a = 0; a < 2; ++a) {
+        const double ratio = std::sqrt(predicted[a] / squared_error[a]);
+        EXPECT_GT(ratio, 0.6) << (a == 0 ? "across" : "along");
+        EXPECT_LT(ratio, 1.6) << (a == 0 ? "across" : "along");
+        std::printf("%s the line of sight: predicted sigma over the true scatter %.2f\n",
+                    a == 0 ? "across" : "along", ratio);
+    }
 }
 
 TEST(PoseCovariance, TheTablesAngleErrorDoesNotWidenWhereTheViewsSit) {
