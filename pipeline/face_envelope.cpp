@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "pipeline/bowed_face.h"
+#include "pipeline/student_t.h"
 #include "pipeline/surface_cells.h"
 
 namespace boxd::envelope {
@@ -86,9 +87,11 @@ struct FaceCells {
             if (tested >= kMinFlatnessCells) out.flatness = chi2 / tested;
         }
         out.view_spread_m = offsets.n >= 2 ? offsets.StdError() * std::sqrt(offsets.n) : 0.0;
-        out.offset_se_m = offsets.n >= 2
-                              ? offsets.StdError()
-                              : spread / std::sqrt(std::max<std::size_t>(1, cells.size()));
+        // The views' own scatter, without CellStats' floor (a face's offset is the mean of
+        // thousands of readings per view), widened for the few views it is estimated from.
+        out.offset_se_m =
+            offsets.n >= 2 ? WidenedForSamples(std::sqrt(offsets.Variance() / offsets.n), offsets.n)
+                           : spread / std::sqrt(std::max<std::size_t>(1, cells.size()));
         ReadExcess(judged, config, out.view_spread_m, &out);
         // A panel bowing out smoothly shows as a whole face (bowed_face.h).
         std::vector<FaceCell> face;

@@ -9,19 +9,16 @@
 #include "pipeline/enclosing_cuboid.h"
 #include "pipeline/fuse_and_fit.h"
 #include "pipeline/object_views.h"
-#include "pipeline/view_stream.h"
 #include "pipeline/refusal.h"
 #include "pipeline/register_views.h"
 #include "pipeline/registration_uncertainty.h"
+#include "pipeline/student_t.h"
 #include "pipeline/table_plane.h"
+#include "pipeline/view_stream.h"
 
 namespace boxd {
 
 namespace {
-
-// The two-sided 95% quantile of the normal distribution: a 1-sigma uncertainty times this is
-// the 95% bound of SPEC section 5's uncertainty_m.
-constexpr double kCoverage95 = 1.959964;
 
 // The result as the stages fill it in.
 struct Measurement {
@@ -131,15 +128,19 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream,
         quality.face_excess_ratio = cuboid->max_relative_excess;
         quality.cuboid_assumed = cuboid->assumed;
         if (std::isfinite(cuboid->flatness)) quality.face_flatness = cuboid->flatness;
-        // The faces' own scatter, and what the registration may still have moved them by.
+        // The faces' own scatter, and what the registration may still have moved them by; the
+        // height is read from the table's plane, which is known as well as its poses agree.
         const auto moved = RegistrationSigma(fit.fused, *cuboid, registered->poses,
                                              registered->pose_covariance);
-        spdlog::debug("uncertainty: faces {:.3f} {:.3f} {:.3f} mm, registration {:.3f} {:.3f} mm",
-                      cuboid->sigma_m[0] * 1e3, cuboid->sigma_m[1] * 1e3,
-                      cuboid->sigma_m[2] * 1e3, moved[0] * 1e3, moved[1] * 1e3);
+        spdlog::debug(
+            "uncertainty: faces {:.3f} {:.3f} {:.3f} mm, registration {:.3f} {:.3f} mm, table "
+            "{:.3f} mm",
+            cuboid->sigma_m[0] * 1e3, cuboid->sigma_m[1] * 1e3, cuboid->sigma_m[2] * 1e3,
+            moved[0] * 1e3, moved[1] * 1e3, table.center_se_m * 1e3);
+        const double beneath[3] = {moved[0], moved[1], table.center_se_m};
         for (std::size_t i = 0; i < 3; ++i) {
-            const double registration = i < 2 ? moved[i] : 0.0;
-            uncertainty[i] = kCoverage95 * std::hypot(cuboid->sigma_m[i], registration);
+            // kNormal95 sigmas: the 95% bound of SPEC section 5's uncertainty_m.
+            uncertainty[i] = kNormal95 * std::hypot(cuboid->sigma_m[i], beneath[i]);
         }
     }
     const auto why = CheckEnclosingCuboid(fit, cuboid, uncertainty, refuse);

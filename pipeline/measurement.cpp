@@ -19,6 +19,13 @@ double Round(double v, double step) {
     return std::round(v * scale) / scale;
 }
 
+// A bound rounded as the value it bounds is: up to `step`, after adding the half step by which
+// the rounded value itself may be off.
+double RoundBound(double v, double step) {
+    const double scale = std::round(1.0 / step);
+    return std::ceil(v * scale + 0.5 - 1e-9) / scale;
+}
+
 json Array3(const std::array<double, 3>& a, double step) {
     return json::array({Round(a[0], step), Round(a[1], step), Round(a[2], step)});
 }
@@ -95,9 +102,9 @@ json ToJson(const MeasurementResult& m) {
     j["shape"] = m.shape.empty() ? json(nullptr) : json(m.shape);
     if (m.uncertainty_m) {
         const auto& u = *m.uncertainty_m;
-        j["uncertainty_m"] = {{"length_m", Round(u.length_m, 1e-5)},
-                              {"width_m", Round(u.width_m, 1e-5)},
-                              {"height_m", Round(u.height_m, 1e-5)}};
+        j["uncertainty_m"] = {{"length_m", RoundBound(u.length_m, 1e-5)},
+                              {"width_m", RoundBound(u.width_m, 1e-5)},
+                              {"height_m", RoundBound(u.height_m, 1e-5)}};
     } else {
         j["uncertainty_m"] = nullptr;
     }

@@ -1,11 +1,14 @@
 #include "pipeline/table_plane.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "pipeline/median.h"
+#include "pipeline/student_t.h"
 
 namespace boxd {
 
@@ -39,6 +42,60 @@ Plane FitPlane(const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& u
     if (plane.normal.dot(up) < 0.0) plane.normal = -plane.normal;
     plane.d = -plane.normal.dot(mean);
     return plane;
+}
+
+// The height above `plane` at the origin of a plane z = a + b x + c y fitted by least squares to
+// the residuals of `pts` within `band` of it; nothing when they do not fix one.
+std::optional<double> HeightAtOrigin(const std::vector<Eigen::Vector3d>& pts, const Plane& plane,
+                                     double band, double* point_variance = nullptr) {
+    Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    std::vector<std::pair<Eigen::Vector3d, double>> rows;
+    for (const Eigen::Vector3d& p : pts) {
+        const double r = plane.normal.dot(p) + plane.d;
+        if (std::abs(r) > band) continue;
+        const Eigen::Vector3d row(1.0, p.x(), p.y());
+        normal += row * row.transpose();
+        rhs += r * row;
+        rows.emplace_back(row, r);
+    }
+    if (rows.size() < 10) return std::nullopt;
+    const Eigen::LDLT<Eigen::Matrix3d> ldlt(normal);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 0.0).all()) return std::nullopt;
+    const Eigen::Vector3d coef = ldlt.solve(rhs);
+    if (point_variance != nullptr) {
+        double sum = 0.0;
+        for (const auto& [row, r] : rows) sum += (r - row.dot(coef)) * (r - row.dot(coef));
+        *point_variance =
+            sum / static_cast<double>(rows.size() - 3) * ldlt.solve(Eigen::Vector3d::UnitX())(0);
+    }
+    return coef(0);
+}
+
+// The standard error of `plane`'s height at the table's centre. Every pose's readings and frames
+// are its own, so the planes the poses give on their own scatter about the pooled one by what
+// its height there is unsure of: whatever the readings share within a pose (its frames'
+// averaging, the disparity levels, the wall's foot), which the readings' own scatter over their
+// count leaves out (about a third of the pooled plane's error on the synthetic station).
+// Widened for the few poses it is estimated from (student_t.h). With one pose, the
+// least-squares error of its readings is all there is.
+double CenterStandardError(const std::vector<std::vector<Eigen::Vector3d>>& poses,
+                           const Plane& plane, double band) {
+    std::vector<double> heights;
+    for (const auto& pose : poses) {
+        if (const auto h = HeightAtOrigin(pose, plane, band)) heights.push_back(*h);
+    }
+    if (heights.size() >= 2) {
+        double mean = 0.0, sq = 0.0;
+        for (double h : heights) mean += h / static_cast<double>(heights.size());
+        for (double h : heights) sq += (h - mean) * (h - mean);
+        const auto n = static_cast<double>(heights.size());
+        return WidenedForSamples(std::sqrt(sq / (n - 1.0) / n), static_cast<int>(heights.size()));
+    }
+    std::vector<Eigen::Vector3d> pts;
+    for (const auto& pose : poses) pts.insert(pts.end(), pose.begin(), pose.end());
+    double variance = 0.0;
+    return HeightAtOrigin(pts, plane, band, &variance) ? std::sqrt(std::max(variance, 0.0)) : 0.0;
 }
 
 }  // namespace
@@ -88,19 +145,20 @@ Result<TablePlaneFit> FitTablePlane(const std::vector<DepthMap>& depths,
                                     const CameraIntrinsics& camera,
                                     const StationCalibration& calibration,
                                     const TablePlaneConfig& config) {
-    std::vector<Eigen::Vector3d> pts;
+    std::vector<std::vector<Eigen::Vector3d>> poses;
+    poses.reserve(depths.size());
     for (const DepthMap& depth : depths) {
-        const std::vector<Eigen::Vector3d> more =
-            TableCandidates(depth, camera, calibration, config);
-        pts.insert(pts.end(), more.begin(), more.end());
+        poses.push_back(TableCandidates(depth, camera, calibration, config));
     }
-    return FitTableCandidates(pts, calibration, config);
+    return FitTableCandidates(poses, calibration, config);
 }
 
-Result<TablePlaneFit> FitTableCandidates(const std::vector<Eigen::Vector3d>& pts,
+Result<TablePlaneFit> FitTableCandidates(const std::vector<std::vector<Eigen::Vector3d>>& poses,
                                          const StationCalibration& calibration,
                                          const TablePlaneConfig& config) {
     const Eigen::Isometry3d recorded = calibration.CameraToTable();
+    std::vector<Eigen::Vector3d> pts;
+    for (const auto& pose : poses) pts.insert(pts.end(), pose.begin(), pose.end());
     if (static_cast<int>(pts.size()) < config.min_points) {
         return Error{
             ErrorCode::kInsufficientData,
@@ -131,6 +189,7 @@ Result<TablePlaneFit> FitTableCandidates(const std::vector<Eigen::Vector3d>& pts
     fit.residual_sigma_m = sigma;
     fit.tilt_correction_deg = std::acos(std::clamp(plane.normal.z(), -1.0, 1.0)) * 180.0 / M_PI;
     fit.height_correction_m = plane.d;  // signed distance of the recorded origin to the plane
+    fit.center_se_m = CenterStandardError(poses, plane, config.trim_sigmas * sigma);
     if (fit.tilt_correction_deg > config.max_tilt_deg ||
         std::abs(fit.height_correction_m) > config.max_shift_m) {
         return Error{ErrorCode::kRegistrationFailed,

@@ -34,6 +34,10 @@ struct TablePlaneFit {
     double tilt_correction_deg = 0.0;  // angle between the recorded and the refitted axis
     double height_correction_m = 0.0;  // recorded origin's height above the refitted plane
     double residual_sigma_m = 0.0;     // robust sigma of the disc points about the plane
+    // Standard error of the plane's height at the table's centre, where a parcel stands: the
+    // spread of each pose's own plane there (its readings and its frames are its own), over
+    // the root of their count. With one pose, the least-squares error of its readings.
+    double center_se_m = 0.0;
     int points = 0;
 };
 
@@ -52,11 +56,11 @@ Result<TablePlaneFit> FitTablePlane(const std::vector<DepthMap>& depths,
                                     const TablePlaneConfig& config);
 
 // FitTablePlane in two steps: the candidate table-top points of one depth map (in the recorded
-// table frame), and the fit of candidates pooled from any number of maps.
+// table frame), and the fit of the candidates of any number of maps, one list per map.
 std::vector<Eigen::Vector3d> TableCandidates(const DepthMap& depth, const CameraIntrinsics& camera,
                                              const StationCalibration& calibration,
                                              const TablePlaneConfig& config);
-Result<TablePlaneFit> FitTableCandidates(const std::vector<Eigen::Vector3d>& candidates,
+Result<TablePlaneFit> FitTableCandidates(const std::vector<std::vector<Eigen::Vector3d>>& poses,
                                          const StationCalibration& calibration,
                                          const TablePlaneConfig& config);
 

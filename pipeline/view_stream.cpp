@@ -126,9 +126,7 @@ bool ViewStream::Accept(std::size_t k, Inspected pose) {
 
 void ViewStream::TryTable() {
     if (provisional_) return;
-    std::vector<Eigen::Vector3d> pooled;
-    for (const auto& c : candidates_) pooled.insert(pooled.end(), c.begin(), c.end());
-    auto fit = FitTableCandidates(pooled, header_.calibration, config_.table_plane);
+    auto fit = FitTableCandidates(candidates_, header_.calibration, config_.table_plane);
     if (fit) {
         provisional_ = *fit;
         table_error_.reset();
@@ -222,9 +220,7 @@ std::optional<MeasurementReason> ViewStream::Complete() {
         completed_ = true;
         // The plane of every pose's table top, and the views moved from the provisional frame
         // into it.
-        std::vector<Eigen::Vector3d> pooled;
-        for (const auto& c : candidates_) pooled.insert(pooled.end(), c.begin(), c.end());
-        auto all = FitTableCandidates(pooled, header_.calibration, config_.table_plane);
+        auto all = FitTableCandidates(candidates_, header_.calibration, config_.table_plane);
         if (!all) {
             table_error_ = all.error();
         } else {

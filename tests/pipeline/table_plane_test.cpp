@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include "tests/support/expect_error.h"
 
@@ -186,6 +187,55 @@ TEST(FitTablePlane, CorrectionBeyondMaxTiltIsAnError) {
     auto fit = FitTablePlane(depths, cam, recorded, config);
     ASSERT_TRUE(fit.ok()) << fit.error().message;
     EXPECT_NEAR(fit->tilt_correction_deg, 4.0, 1e-3);
+}
+
+// `poses` depth maps of the bare table seen through the exact calibration, each with readings
+// `pixel_sigma` apart and all of one pose `pose_sigma` off together (what a pose's frames share).
+std::vector<DepthMap> NoisyPoses(int poses, double pixel_sigma, double pose_sigma, unsigned seed) {
+    const CameraIntrinsics cam;
+    const DepthMap clean = Render(cam, Recorded().CameraToTable(), nullptr);
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> pixel(0.0, pixel_sigma), pose(0.0, pose_sigma);
+    std::vector<DepthMap> out;
+    for (int k = 0; k < poses; ++k) {
+        DepthMap d = clean;
+        const double shift = pose(rng);
+        for (float& z : d.z_m) {
+            if (z > 0.0f) z += static_cast<float>(shift + pixel(rng));
+        }
+        out.push_back(std::move(d));
+    }
+    return out;
+}
+
+TEST(FitTablePlane, CentreStandardErrorIsWhatThePosesScatterSays) {
+    // Readings a millimetre apart and poses 0.1 mm apart: the plane's height at the centre errs
+    // by about 0.1 mm over the root of the poses, which the readings' own scatter over their
+    // count (tens of thousands) would put ten times too small.
+    const CameraIntrinsics cam;
+    double squared_error = 0.0, predicted = 0.0;
+    const int trials = 32;
+    for (int t = 0; t < trials; ++t) {
+        const auto depths = NoisyPoses(8, 0.001, 0.0001, 900 + static_cast<unsigned>(t));
+        const auto fit = FitTablePlane(depths, cam, Recorded(), TablePlaneConfig{});
+        ASSERT_TRUE(fit.ok()) << fit.error().message;
+        squared_error += fit->height_correction_m * fit->height_correction_m;
+        predicted += fit->center_se_m * fit->center_se_m;
+    }
+    const double ratio = std::sqrt(predicted / squared_error);
+    std::printf("centre standard error over the true scatter: %.2f\n", ratio);
+    EXPECT_GT(ratio, 0.6);
+    EXPECT_LT(ratio, 1.6);
+}
+
+TEST(FitTablePlane, OnePoseGivesItsReadingsOwnStandardError) {
+    const CameraIntrinsics cam;
+    const auto fit =
+        FitTablePlane(NoisyPoses(1, 0.001, 0.0, 7), cam, Recorded(), TablePlaneConfig{});
+    ASSERT_TRUE(fit.ok()) << fit.error().message;
+    // About a millimetre (its vertical share) over the root of ~30,000 readings.
+    EXPECT_GT(fit->center_se_m, 0.000002);
+    EXPECT_LT(fit->center_se_m, 0.00002);
 }
 
 }  // namespace
