@@ -3,9 +3,10 @@
 with many noise seeds, measures each (`boxd measure`), and prints per dimension the errors' mean
 and standard deviation against the median 95% bound: a calibrated bound is about 1.96 standard
 deviations of the error, and the median bound about 2.9 times the median |error|. With --split,
-each run's debug log gives the bound's parts (1 sigma, mm): the faces' own and the registration's.
-With --group, every measured case of that group (e.g. box, the ideal boxes) is rendered with the
-seeds, one line per case, and the whole group's count within bound after them. --synth adds
+each run's debug log gives the bound's parts (1 sigma, mm): the faces' own, the registration's and
+the table's (the height's). With --group, every measured case of that group (e.g. box, the ideal
+boxes) is rendered with the seeds, one line per case with its median bounds, and the whole
+group's count within bound after them, per dimension too. --synth adds
 `boxd synth` options to every rendering (e.g. a station without errors, or another depth unit).
 
 Usage: scripts/seed_study.py [--boxd build/daemon/boxd] [--case reference | --group box]
