@@ -137,10 +137,10 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream,
             "{:.3f} mm",
             cuboid->sigma_m[0] * 1e3, cuboid->sigma_m[1] * 1e3, cuboid->sigma_m[2] * 1e3,
             moved[0] * 1e3, moved[1] * 1e3, table.center_se_m * 1e3);
-        const double beneath[3] = {moved[0], moved[1], table.center_se_m};
+        const double shared[3] = {moved[0], moved[1], table.center_se_m};  // by every face alike
         for (std::size_t i = 0; i < 3; ++i) {
             // kNormal95 sigmas: the 95% bound of SPEC section 5's uncertainty_m.
-            uncertainty[i] = kNormal95 * std::hypot(cuboid->sigma_m[i], beneath[i]);
+            uncertainty[i] = kNormal95 * std::hypot(cuboid->sigma_m[i], shared[i]);
         }
     }
     const auto why = CheckEnclosingCuboid(fit, cuboid, uncertainty, refuse);

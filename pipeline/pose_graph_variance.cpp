@@ -152,7 +152,7 @@ Status SolveWeighedByTheData(PoseGraph& graph, const PoseGraphConfig& config) {
         std::array<double, kGroups> factor;
         factor.fill(1.0);
         if (!VarianceComponentCovariance(*lin, &factor)) break;
-        for (int part = 0; part < 3; ++part) {
+        for (int part = kEdgeAcross; part <= kEdgeYaw; ++part) {
             weighed.edge_part_scale[static_cast<std::size_t>(part)] *=
                 std::sqrt(factor[static_cast<std::size_t>(part)]);
         }
