@@ -50,24 +50,25 @@ std::optional<double> HeightAtOrigin(const std::vector<Eigen::Vector3d>& pts, co
                                      double band, double* point_variance = nullptr) {
     Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
     Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
-    std::vector<std::pair<Eigen::Vector3d, double>> rows;
+    double squares = 0.0;
+    int count = 0;
     for (const Eigen::Vector3d& p : pts) {
         const double r = plane.normal.dot(p) + plane.d;
         if (std::abs(r) > band) continue;
         const Eigen::Vector3d row(1.0, p.x(), p.y());
         normal += row * row.transpose();
         rhs += r * row;
-        rows.emplace_back(row, r);
+        squares += r * r;
+        ++count;
     }
-    if (rows.size() < 10) return std::nullopt;
+    if (count < 10) return std::nullopt;
     const Eigen::LDLT<Eigen::Matrix3d> ldlt(normal);
     if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 0.0).all()) return std::nullopt;
     const Eigen::Vector3d coef = ldlt.solve(rhs);
     if (point_variance != nullptr) {
-        double sum = 0.0;
-        for (const auto& [row, r] : rows) sum += (r - row.dot(coef)) * (r - row.dot(coef));
-        *point_variance =
-            sum / static_cast<double>(rows.size() - 3) * ldlt.solve(Eigen::Vector3d::UnitX())(0);
+        // The residuals' sum of squares about the fit is their own less what the fit explains.
+        const double residual = std::max(squares - coef.dot(rhs), 0.0);
+        *point_variance = residual / (count - 3) * ldlt.solve(Eigen::Vector3d::UnitX())(0);
     }
     return coef(0);
 }
