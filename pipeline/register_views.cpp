@@ -43,8 +43,9 @@ Result<RegisteredViews> SolveViewGraph(std::vector<PoseEdge> edges, const EdgeSt
     // covariance matches the edges' random errors: their whitened errors against the truth
     // have RMS 0.99-1.06 across and along the line of sight. A view's own error entering every
     // edge aligned onto it, modelled as such, comes out at 0.01-0.015 mm and leaves the
-    // covariance as it is. Without the widening the ideal boxes' bounds would be 2.3 / 2.7
-    // times their median error but hold 92.5% of them, not 95%.
+    // covariance as it is. The widening is an allowance, not the lean's measure: without it
+    // the ideal boxes' bounds would be 2.3 / 2.7 times their median error but hold 92.5% of
+    // them, not 95%. It goes when the lean is removed where it arises.
     if (!graph.poses.empty()) {
         const double shared =
             static_cast<double>(report->active_edges) / static_cast<double>(graph.poses.size());
