@@ -131,7 +131,9 @@ void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Problem
         const Eigen::Matrix3d info =
             e.point_scatter / (config.edge_displacement_sigma_m * config.edge_displacement_sigma_m);
         Eigen::Matrix3d sqrt_info = SqrtInformation(info);
-        for (int row = 0; row < 3; ++row) sqrt_info.row(row) /= config.edge_part_scale[row];
+        for (int row = 0; row < 3; ++row) {
+            sqrt_info.row(row) *= std::sqrt(e.row_weight(row)) / config.edge_part_scale[row];
+        }
         p.problem->AddResidualBlock(RelativeCost::Create(e.measured, sqrt_info), loss,
                                     p.params[static_cast<std::size_t>(e.from)].data(),
                                     p.params[static_cast<std::size_t>(e.to)].data());
@@ -194,6 +196,7 @@ Status PoseGraphConfig::Validate() const {
         if (!(scale > 0.0 && std::isfinite(scale))) return bad("edge_part_scale", "must be > 0");
     }
     if (!(loop_huber_scale > 0.0)) return bad("loop_huber_scale", "must be > 0");
+    if (!(row_huber_scale > 0.0)) return bad("row_huber_scale", "must be > 0");
     if (!(max_edge_displacement_m > 0.0)) return bad("max_edge_displacement_m", "must be > 0");
     if (max_rejection_rounds < 0) return bad("max_rejection_rounds", "must be >= 0");
     if (max_solver_iterations < 1) return bad("max_solver_iterations", "must be >= 1");

@@ -27,6 +27,9 @@ struct PoseGraphConfig {
     // variance components set them (variance_rounds); 1 weighs the three as the sigma says.
     std::array<double, 3> edge_part_scale = {1.0, 1.0, 1.0};
     double loop_huber_scale = 2.0;  // Huber loss on loop closures, in edge sigmas
+    // In the weighed solve, an edge's residual row beyond this many sigmas of its kind counts
+    // as Huber's loss says (its weight falls as one over the residual).
+    double row_huber_scale = 2.0;
     // An edge whose solved residual moves its surfaces by more than this (RMS along the normals)
     // is rejected and the graph re-solved. Directions the edge's data do not constrain (sliding
     // along a face) do not count.
@@ -50,6 +53,9 @@ struct PoseEdge {
     Eigen::Matrix3d point_scatter = Eigen::Matrix3d::Identity();  // per-point JᵀJ / N
     bool loop_closure = false;
     bool rejected = false;
+    // How much each residual row counts: 1, or less for a row that errs far beyond the scatter
+    // of its kind (row_huber_scale; set by the weighed solve, pose_graph_variance.cpp).
+    Eigen::Vector3d row_weight = Eigen::Vector3d::Ones();
 };
 
 // Node k's pose maps view k's points into the frame of view 0 (held constant).
@@ -80,7 +86,8 @@ Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfi
 // Returns the covariance of the solved poses, 3N x 3N in (x, y, yaw) per node (node 0 defines
 // the frame: its rows are zero). The inverse of JᵀJ of the whitened residuals at the solution,
 // with the ICP edges' three rows and the turntable prior's translations and yaws each weighted
-// by its variance component estimated from its own residuals (Förstner): the configured sigmas
+// by its variance component estimated from its own residuals (Förstner), and each edge's rows by
+// their weights (PoseEdge::row_weight, from the weighed solve): the configured sigmas
 // only weigh the solve, the scatter the solution shows decides how well the poses are known.
 // Without redundancy (no edges: the turntable model alone) the prior's configured sigmas, per
 // node.

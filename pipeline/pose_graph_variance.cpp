@@ -113,6 +113,22 @@ std::optional<Eigen::MatrixXd> VarianceComponentCovariance(
     return inverse;
 }
 
+// Sets each kept edge's row weights to Huber's for its residual at `lin` in sigmas of its group
+// once the group's variance has changed by `factor`: 1 within `huber` sigmas, huber / |z|
+// beyond. The residuals at `lin` are weighed by the rows' present weights, which come off first.
+void ReweighRows(const Linearization& lin, const std::array<double, kGroups>& factor, double huber,
+                 std::vector<PoseEdge>& edges) {
+    Eigen::Index r = 0;
+    for (PoseEdge& e : edges) {
+        if (e.rejected) continue;
+        for (int row = 0; row < 3 && r < lin.edge_rows; ++row, ++r) {
+            const double z = std::abs(lin.residuals(r)) /
+                             std::sqrt(e.row_weight(row) * factor[static_cast<std::size_t>(row)]);
+            e.row_weight(row) = z > huber ? huber / z : 1.0;
+        }
+    }
+}
+
 }  // namespace
 
 Eigen::MatrixXd PoseCovariance(const PoseGraph& graph, const PoseGraphConfig& config) {
@@ -143,6 +159,13 @@ namespace pose_graph_internal {
 // the edges hardly fix: the table's centre along the camera's line of sight, which moves every
 // face alike (a 0.6 m box grew by 0.5 mm on a table with 0.3-degree angle errors). Weighed by
 // what their residuals show, each source counts as much as it is worth on this capture.
+//
+// Within a group, a row that errs far beyond the group's scatter counts less (Huber's weights,
+// row_huber_scale, re-set every round). ICP edges err with a heavy tail: a few alignments err
+// by ten times their peers across the line of sight. With one weight for the group, those few
+// bend the poses and set the group's variance component, which widens every pose's covariance.
+// The accuracy suite's off-centre box rendered with seed 100: the footprint 0.30 / 0.40 mm off with a
+// registration sigma of 0.34 mm; weighed by rows, 0.12 / 0.16 mm and 0.19 mm.
 Status SolveWeighedByTheData(PoseGraph& graph, const PoseGraphConfig& config) {
     if (graph.poses.size() < 2) return OkStatus();
     PoseGraphConfig weighed = config;
@@ -158,6 +181,7 @@ Status SolveWeighedByTheData(PoseGraph& graph, const PoseGraphConfig& config) {
         }
         weighed.prior_center_sigma_m *= std::sqrt(factor[kPriorTranslation]);
         weighed.prior_yaw_sigma_rad *= std::sqrt(factor[kPriorYaw]);
+        ReweighRows(*lin, factor, config.row_huber_scale, graph.edges);
         if (Status s = SolvePoseGraph(graph, weighed); !s) return s;
     }
     return OkStatus();
