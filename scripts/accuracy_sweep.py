@@ -125,7 +125,9 @@ def run_case(boxd, case):
     if result["status"] != "ok":
         out["reason"] = (result.get("reason") or {}).get("code", "")
         return out
-    out["error_mm"] = [1000 * (result["dimensions"][k] - truth[k]) for k in KEYS]
+    # Rounded to the nanometre, so that an error equal to its bound (both written to the
+    # hundredth of a millimetre) is not pushed past it by the doubles' difference.
+    out["error_mm"] = [round(1000 * (result["dimensions"][k] - truth[k]), 6) for k in KEYS]
     out["bound_mm"] = [1000 * result["uncertainty_m"][k] for k in KEYS]
     out["shape"] = result["shape"]
     return out

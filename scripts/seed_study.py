@@ -48,7 +48,9 @@ def measure(boxd, case, seed, tmp, split):
         return seed, None, None, r.get("reason", {}).get("code")
     with open(os.path.join(out, "session.json")) as f:
         truth = json.load(f)["ground_truth"]
-    err = [(r["dimensions"][k] - truth[k]) * 1e3 for k in KEYS]
+    # Rounded to the nanometre: the dimension and the truth are written to the hundredth of a
+    # millimetre, and their difference in doubles may pass an equal bound by 1e-17.
+    err = [round((r["dimensions"][k] - truth[k]) * 1e3, 6) for k in KEYS]
     bound = [r["uncertainty_m"][k] * 1e3 for k in KEYS]
     parts = SPLIT.search(run.stderr) if split else None
     return seed, err, bound, parts.groups() if parts else ""
