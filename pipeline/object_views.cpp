@@ -9,9 +9,9 @@ void SegmentObjectView(const DepthMap& depth, const CameraIntrinsics& camera,
                        const Eigen::Isometry3d& camera_to_table,
                        const SegmentationConfig& segmentation,
                        const RegistrationCloudConfig& coarse_cloud,
-                       const RegistrationCloudConfig& fine_cloud, bool keep_points,
+                       const RegistrationCloudConfig& fine_cloud, bool keep_points, int view_index,
                        SegmentedView* view, RegistrationClouds* clouds) {
-    *view = SegmentView(depth, camera, calibration, camera_to_table, segmentation);
+    *view = SegmentView(depth, camera, calibration, camera_to_table, segmentation, view_index);
     *clouds = BuildRegistrationClouds(view->points, coarse_cloud, fine_cloud,
                                       camera_to_table.translation().cast<float>());
     // A single view keeps every pixel: with no other view to fuse, its faces' edges are all
@@ -32,7 +32,7 @@ ObjectViews SegmentObjectViews(const std::vector<DepthMap>& depths, const Camera
     ParallelFor(n, threads, [&](int k) {
         const auto i = static_cast<std::size_t>(k);
         SegmentObjectView(depths[i], camera, calibration, camera_to_table, segmentation,
-                          coarse_cloud, fine_cloud, n == 1, &out.views[i], &out.clouds[i]);
+                          coarse_cloud, fine_cloud, n == 1, k, &out.views[i], &out.clouds[i]);
     });
     for (const SegmentedView& v : out.views) {
         out.fusion_points += static_cast<long>(v.fusion_points.size());

@@ -20,14 +20,15 @@ struct ObjectViews {
 };
 
 // Returns one view of the averaged `depth`: its object points and its registration clouds
-// (normals facing the camera, at `camera_to_table`'s origin). Unless `keep_points`, the
-// full-density points are dropped once the clouds are built (only a single view needs them).
+// (normals facing the camera, at `camera_to_table`'s origin); `view_index` is the pose's index.
+// Unless `keep_points`, the full-density points are dropped once the clouds are built (only a
+// single view needs them).
 void SegmentObjectView(const DepthMap& depth, const CameraIntrinsics& camera,
                        const StationCalibration& calibration,
                        const Eigen::Isometry3d& camera_to_table,
                        const SegmentationConfig& segmentation,
                        const RegistrationCloudConfig& coarse_cloud,
-                       const RegistrationCloudConfig& fine_cloud, bool keep_points,
+                       const RegistrationCloudConfig& fine_cloud, bool keep_points, int view_index,
                        SegmentedView* view, RegistrationClouds* clouds);
 
 // Returns the object views of the averaged `depths` (one per pose) on `threads` threads.

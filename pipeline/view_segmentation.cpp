@@ -1,6 +1,7 @@
 #include "pipeline/view_segmentation.h"
 
 #include <cmath>
+#include <cstdint>
 
 namespace boxd {
 
@@ -8,6 +9,19 @@ namespace {
 
 Status Bad(const std::string& field, const std::string& why) {
     return Error{ErrorCode::kInvalidConfig, "segmentation." + field + ": " + why};
+}
+
+// Returns which pixel of the stride x stride block (bu, bv) the fusion keeps in view `view`:
+// row-major within the block, drawn by a fixed hash (splitmix64's finaliser).
+int BlockPick(int view, int bu, int bv, int stride) {
+    std::uint64_t x = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(view)) << 42) ^
+                      (static_cast<std::uint64_t>(static_cast<std::uint32_t>(bu)) << 21) ^
+                      static_cast<std::uint64_t>(static_cast<std::uint32_t>(bv));
+    x += 0x9E3779B97F4A7C15ULL;
+    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
+    x ^= x >> 31;
+    return static_cast<int>(x % static_cast<std::uint64_t>(stride * stride));
 }
 
 }  // namespace
@@ -31,7 +45,7 @@ Status SegmentationConfig::Validate() const {
 SegmentedView SegmentView(const DepthMap& depth, const CameraIntrinsics& camera,
                           const StationCalibration& calibration,
                           const Eigen::Isometry3d& camera_to_table,
-                          const SegmentationConfig& config) {
+                          const SegmentationConfig& config, int view_index) {
     SegmentedView view;
     const Eigen::Matrix3f rot = camera_to_table.linear().cast<float>();
     const Eigen::Vector3f trans = camera_to_table.translation().cast<float>();
@@ -61,7 +75,9 @@ SegmentedView SegmentView(const DepthMap& depth, const CameraIntrinsics& camera,
                 continue;
             }
             view.points.push_back(p);
-            if (u % config.fusion_pixel_stride == 0 && v % config.fusion_pixel_stride == 0) {
+            const int stride = config.fusion_pixel_stride;
+            if ((u % stride) + stride * (v % stride) ==
+                BlockPick(view_index, u / stride, v / stride, stride)) {
                 view.fusion_points.push_back(p);
             }
             if (u < m || v < m || u >= depth.width - m || v >= depth.height - m) {

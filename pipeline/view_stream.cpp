@@ -138,8 +138,8 @@ void ViewStream::TryTable() {
 void ViewStream::SegmentInto(std::size_t k, const DepthMap& depth) {
     SegmentObjectView(depth, header_.camera, header_.calibration, provisional_->camera_to_table,
                       config_.segmentation, config_.registration.coarse_cloud,
-                      config_.registration.fine_cloud, Planned() == 1, &views_.views[k],
-                      &views_.clouds[k]);
+                      config_.registration.fine_cloud, Planned() == 1, static_cast<int>(k),
+                      &views_.views[k], &views_.clouds[k]);
     targets_[k] = std::make_unique<ViewTargets>(views_.clouds[k], config_.registration);
 }
 

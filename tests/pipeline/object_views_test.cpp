@@ -62,13 +62,17 @@ TEST(SegmentObjectViews, FusionPointCountsAddUp) {
     const ObjectViews ov = Segment(ThreeViews(), 1);
     ASSERT_EQ(ov.views.size(), 3u);
     ASSERT_EQ(ov.clouds.size(), 3u);
-    // The fusion stride keeps pixels with u and v multiples of 3. View 0: u in {36, ..., 57}
-    // (8) times v in {27, ..., 45} (7); view 1: u in {39, ..., 57} (7) times v in {30, ..., 42}
-    // (5); the bare table none.
-    EXPECT_EQ(ov.views[0].fusion_points.size(), 56u);
-    EXPECT_EQ(ov.views[1].fusion_points.size(), 35u);
+    // The fusion keeps one pixel of each 3 x 3 block. View 0: u in [36, 60) (8 blocks) times
+    // v in [26, 46) (6 whole blocks, and v = 45 of a seventh); view 1: u in [38, 58) (6 whole
+    // blocks, and u = 38 and 57 of two more) times v in [28, 44) (5 whole blocks, and v = 28 and
+    // 43 of two more); the bare table none.
+    EXPECT_GE(ov.views[0].fusion_points.size(), 48u);
+    EXPECT_LE(ov.views[0].fusion_points.size(), 56u);
+    EXPECT_GE(ov.views[1].fusion_points.size(), 30u);
+    EXPECT_LE(ov.views[1].fusion_points.size(), 56u);
     EXPECT_EQ(ov.views[2].fusion_points.size(), 0u);
-    EXPECT_EQ(ov.fusion_points, 56 + 35);
+    EXPECT_EQ(ov.fusion_points, static_cast<long>(ov.views[0].fusion_points.size() +
+                                                  ov.views[1].fusion_points.size()));
     for (const SegmentedView& v : ov.views) {
         EXPECT_EQ(v.valid_pixels, 96 * 72);
         EXPECT_EQ(v.border_points, 0);
@@ -95,7 +99,7 @@ TEST(SegmentObjectViews, RegistrationCloudsOfEachViewsObjectPoints) {
         EXPECT_LE(ov.clouds[k].coarse.points.size(), ov.clouds[k].fine.points.size());
         // Exactly the clouds of the view's full-density object points.
         const SegmentedView alone = SegmentView(depths[k], DownCamera(), StationCalibration{},
-                                                LookingDown(), SmallVolume());
+                                                LookingDown(), SmallVolume(), static_cast<int>(k));
         ASSERT_FALSE(alone.points.empty());
         const RegistrationClouds expected =
             BuildRegistrationClouds(alone.points, reg.coarse_cloud, reg.fine_cloud,

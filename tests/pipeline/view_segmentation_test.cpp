@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "tests/support/down_camera.h"
@@ -40,10 +41,17 @@ SegmentationConfig SmallVolume() {
     return c;
 }
 
+// ... and one wide enough for a box over most of the image.
+SegmentationConfig WideVolume() {
+    SegmentationConfig c = SmallVolume();
+    c.cylinder_radius_m = 0.6;
+    return c;
+}
+
 TEST(SegmentView, BareTableHasNoObjectPoints) {
     const CameraIntrinsics cam = SmallCamera();
     const SegmentedView view =
-        SegmentView(Table(cam), cam, StationCalibration{}, LookingDown(), SmallVolume());
+        SegmentView(Table(cam), cam, StationCalibration{}, LookingDown(), SmallVolume(), 0);
     EXPECT_EQ(view.valid_pixels, 64 * 48);
     EXPECT_TRUE(view.points.empty());
     EXPECT_EQ(view.outside_points, 0);
@@ -60,19 +68,67 @@ TEST(SegmentView, KeepsBoxAboveMinHeightWithFusionStrideSubset) {
     Raise(depth, 5, 10, 5, 10, 0.005);
     depth.at(0, 47) = 0.0f;  // a missing reading
     const SegmentedView view =
-        SegmentView(depth, cam, StationCalibration{}, LookingDown(), SmallVolume());
+        SegmentView(depth, cam, StationCalibration{}, LookingDown(), SmallVolume(), 0);
     EXPECT_EQ(view.valid_pixels, 64 * 48 - 1);
     ASSERT_EQ(view.points.size(), 20u * 15u);
     // Row-major order: the first point is pixel (20, 15) at depth 0.9.
     EXPECT_NEAR(view.points[0].x(), (20 - 31.5) / 50.0 * 0.9, 1e-5);
     EXPECT_NEAR(view.points[0].y(), -(15 - 23.5) / 50.0 * 0.9, 1e-5);
     for (const Eigen::Vector3f& p : view.points) EXPECT_NEAR(p.z(), 0.1, 1e-5);
-    // Stride 3: u in {21, 24, ..., 39} (7) times v in {15, 18, ..., 27} (5).
-    ASSERT_EQ(view.fusion_points.size(), 35u);
-    EXPECT_NEAR(view.fusion_points[0].x(), (21 - 31.5) / 50.0 * 0.9, 1e-5);
-    EXPECT_NEAR(view.fusion_points[0].y(), -(15 - 23.5) / 50.0 * 0.9, 1e-5);
+    // One pixel of each 3 x 3 block: the 6 x 5 blocks wholly on the box (u in [21, 39)) give one
+    // each, the 2 x 5 it covers a column of (u = 20 and u = 39) one where that column is drawn.
+    EXPECT_GE(view.fusion_points.size(), 30u);
+    EXPECT_LE(view.fusion_points.size(), 40u);
+    for (const Eigen::Vector3f& f : view.fusion_points) {
+        EXPECT_NE(std::find(view.points.begin(), view.points.end(), f), view.points.end());
+    }
     EXPECT_EQ(view.border_points, 0);
     EXPECT_EQ(view.outside_points, 0);
+}
+
+TEST(SegmentView, EachViewDrawsItsOwnFusionPixels) {
+    const CameraIntrinsics cam = SmallCamera();
+    DepthMap depth = Table(cam);
+    Raise(depth, 12, 51, 6, 42, 0.1);
+    const SegmentedView a =
+        SegmentView(depth, cam, StationCalibration{}, LookingDown(), WideVolume(), 0);
+    const SegmentedView b =
+        SegmentView(depth, cam, StationCalibration{}, LookingDown(), WideVolume(), 1);
+    // 13 x 12 blocks, all wholly on the box: one pixel each, not the same ones.
+    ASSERT_EQ(a.fusion_points.size(), 156u);
+    ASSERT_EQ(b.fusion_points.size(), 156u);
+    int same = 0;
+    for (std::size_t i = 0; i < a.fusion_points.size(); ++i) {
+        same += a.fusion_points[i] == b.fusion_points[i] ? 1 : 0;
+    }
+    EXPECT_LT(same, 156 / 2);
+}
+
+TEST(SegmentView, FusionPixelsReadAQuantisedSlopeWithoutBias) {
+    // A top rising 1/3 mm a pixel row, its depths recorded in whole millimetres: on a fixed
+    // grid of every third row every sample rounds alike (the same 0.3 mm), and the face's mean
+    // would be off by that; one pixel drawn per block meets the three roundings evenly.
+    const CameraIntrinsics cam = SmallCamera();
+    DepthMap depth = Table(cam);
+    auto true_height = [](int v) { return 0.1003 + (v - 6) / 3.0 * 1e-3; };
+    for (int v = 6; v < 42; ++v) {
+        for (int u = 12; u < 51; ++u) {
+            const double z = kCameraHeight - true_height(v);
+            depth.at(u, v) = static_cast<float>(std::round(z * 1e3) * 1e-3);
+        }
+    }
+    const SegmentedView view =
+        SegmentView(depth, cam, StationCalibration{}, LookingDown(), WideVolume(), 0);
+    ASSERT_EQ(view.fusion_points.size(), 156u);
+    double sum = 0.0;
+    for (const Eigen::Vector3f& p : view.fusion_points) {
+        // Back from the point's height to its row: y = -(v - cy) / fy * z.
+        const double z = kCameraHeight - p.z();
+        const int v = static_cast<int>(std::lround(23.5 - p.y() / z * 50.0));
+        sum += p.z() - true_height(v);
+    }
+    // Every third row alone: -0.3 mm; every row: -0.033 mm.
+    EXPECT_LT(std::abs(sum / 156.0), 0.15e-3);
 }
 
 TEST(SegmentView, AppliesDepthCorrectionAndTableFrame) {
@@ -86,7 +142,7 @@ TEST(SegmentView, AppliesDepthCorrectionAndTableFrame) {
     // The table frame turned by 90 degrees about its axis: table (x, y) -> (-y, x).
     Eigen::Isometry3d turn = Eigen::Isometry3d::Identity();
     turn.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-    const SegmentedView view = SegmentView(depth, cam, cal, turn * LookingDown(), SmallVolume());
+    const SegmentedView view = SegmentView(depth, cam, cal, turn * LookingDown(), SmallVolume(), 0);
     EXPECT_EQ(view.valid_pixels, 2);
     ASSERT_EQ(view.points.size(), 1u);
     const double x = (40 - 31.5) / 50.0 * 0.8, y = -(30 - 23.5) / 50.0 * 0.8;
@@ -102,7 +158,8 @@ TEST(SegmentView, CountsObjectReadingsAtTheImageBorder) {
     Raise(depth, 0, 5, 20, 28, 0.1);
     SegmentationConfig config = SmallVolume();
     config.cylinder_radius_m = 0.8;  // the image corners are at 0.71 m: all inside
-    const SegmentedView view = SegmentView(depth, cam, StationCalibration{}, LookingDown(), config);
+    const SegmentedView view =
+        SegmentView(depth, cam, StationCalibration{}, LookingDown(), config, 0);
     EXPECT_EQ(view.points.size(), 5u * 8u);
     EXPECT_EQ(view.border_points, 2 * 8);
     EXPECT_EQ(view.outside_points, 0);
@@ -118,7 +175,7 @@ TEST(SegmentView, CountsReadingsJustOutsideTheCylinder) {
     // u = 60 and 61 are at x = 0.51 m, beyond the band: neither object nor outside.
     Raise(depth, 60, 62, 22, 26, 0.1);
     const SegmentedView view =
-        SegmentView(depth, cam, StationCalibration{}, LookingDown(), SmallVolume());
+        SegmentView(depth, cam, StationCalibration{}, LookingDown(), SmallVolume(), 0);
     EXPECT_TRUE(view.points.empty());
     EXPECT_EQ(view.outside_points, 4 * 4);
     EXPECT_EQ(view.border_points, 0);
