@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <vector>
 
 namespace boxd {
 
@@ -59,7 +60,14 @@ SegmentedView SegmentView(const DepthMap& depth, const CameraIntrinsics& camera,
     const CameraIntrinsics lens = calibration.Lens(camera);
     const float inv_fx = static_cast<float>(1.0 / lens.fx);
     const float inv_fy = static_cast<float>(1.0 / lens.fy);
+    // The fusion's pixel of each block of the row of blocks `v` is in (BlockPick).
+    const int stride = config.fusion_pixel_stride;
+    std::vector<int> picks(static_cast<std::size_t>(depth.width / stride + 1));
     for (int v = 0; v < depth.height; ++v) {
+        if (v % stride == 0) {
+            for (std::size_t b = 0; b < picks.size(); ++b)
+                picks[b] = BlockPick(view_index, static_cast<int>(b), v / stride, stride);
+        }
         const float ry = (static_cast<float>(v) - static_cast<float>(camera.cy)) * inv_fy;
         for (int u = 0; u < depth.width; ++u) {
             const float raw = depth.at(u, v);
@@ -75,9 +83,8 @@ SegmentedView SegmentView(const DepthMap& depth, const CameraIntrinsics& camera,
                 continue;
             }
             view.points.push_back(p);
-            const int stride = config.fusion_pixel_stride;
             if ((u % stride) + stride * (v % stride) ==
-                BlockPick(view_index, u / stride, v / stride, stride)) {
+                picks[static_cast<std::size_t>(u / stride)]) {
                 view.fusion_points.push_back(p);
             }
             if (u < m || v < m || u >= depth.width - m || v >= depth.height - m) {
