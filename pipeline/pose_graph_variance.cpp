@@ -164,8 +164,8 @@ namespace pose_graph_internal {
 // row_huber_scale, re-set every round). ICP edges err with a heavy tail: a few alignments err
 // by ten times their peers across the line of sight. With one weight for the group, those few
 // bend the poses and set the group's variance component, which widens every pose's covariance.
-// The accuracy suite's off-centre box rendered with seed 100: the footprint 0.30 / 0.40 mm off with a
-// registration sigma of 0.34 mm; weighed by rows, 0.12 / 0.16 mm and 0.19 mm.
+// The accuracy suite's off-centre box rendered with seed 100: the footprint 0.30 / 0.40 mm off
+// with a registration sigma of 0.34 mm; weighed by rows, 0.12 / 0.16 mm and 0.19 mm.
 Status SolveWeighedByTheData(PoseGraph& graph, const PoseGraphConfig& config) {
     if (graph.poses.size() < 2) return OkStatus();
     PoseGraphConfig weighed = config;

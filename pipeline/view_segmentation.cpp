@@ -60,7 +60,7 @@ SegmentedView SegmentView(const DepthMap& depth, const CameraIntrinsics& camera,
     const CameraIntrinsics lens = calibration.Lens(camera);
     const float inv_fx = static_cast<float>(1.0 / lens.fx);
     const float inv_fy = static_cast<float>(1.0 / lens.fy);
-    // The fusion's pixel of each block of the row of blocks `v` is in (BlockPick).
+    // The pixel BlockPick draws in each block of the current row of blocks.
     const int stride = config.fusion_pixel_stride;
     std::vector<int> picks(static_cast<std::size_t>(depth.width / stride + 1));
     for (int v = 0; v < depth.height; ++v) {
