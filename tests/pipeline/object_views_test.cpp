@@ -62,14 +62,15 @@ TEST(SegmentObjectViews, FusionPointCountsAddUp) {
     const ObjectViews ov = Segment(ThreeViews(), 1);
     ASSERT_EQ(ov.views.size(), 3u);
     ASSERT_EQ(ov.clouds.size(), 3u);
-    // The fusion keeps one pixel of each 3 x 3 block. View 0: u in [36, 60) (8 blocks) times
-    // v in [26, 46) (6 whole blocks, and v = 45 of a seventh); view 1: u in [38, 58) (6 whole
-    // blocks, and u = 38 and 57 of two more) times v in [28, 44) (5 whole blocks, and v = 28 and
-    // 43 of two more); the bare table none.
+    // The fusion keeps one pixel of each 3 x 3 block: one from each block wholly on the box, one
+    // or none from a block it covers in part. View 0: u in [36, 60) (8 whole columns of blocks)
+    // times v in [26, 46) (6 whole rows, and a row of 26 and one of 45): 48 to 64. View 1: u in
+    // [38, 58) (6 whole columns, and a column of 38 and one of 57) times v in [28, 44) (4 whole
+    // rows, and rows of 28-29 and of 42-43): 24 to 48. The bare table none.
     EXPECT_GE(ov.views[0].fusion_points.size(), 48u);
-    EXPECT_LE(ov.views[0].fusion_points.size(), 56u);
-    EXPECT_GE(ov.views[1].fusion_points.size(), 30u);
-    EXPECT_LE(ov.views[1].fusion_points.size(), 56u);
+    EXPECT_LE(ov.views[0].fusion_points.size(), 64u);
+    EXPECT_GE(ov.views[1].fusion_points.size(), 24u);
+    EXPECT_LE(ov.views[1].fusion_points.size(), 48u);
     EXPECT_EQ(ov.views[2].fusion_points.size(), 0u);
     EXPECT_EQ(ov.fusion_points, static_cast<long>(ov.views[0].fusion_points.size() +
                                                   ov.views[1].fusion_points.size()));
