@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "pipeline/mix_bits.h"
+
 namespace boxd {
 
 namespace {
@@ -13,16 +15,12 @@ Status Bad(const std::string& field, const std::string& why) {
 }
 
 // Returns which pixel of the stride x stride block (bu, bv) the fusion keeps in view `view`:
-// row-major within the block, drawn by a fixed hash (splitmix64's finaliser).
+// row-major within the block, drawn by a fixed hash.
 int BlockPick(int view, int bu, int bv, int stride) {
-    std::uint64_t x = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(view)) << 42) ^
-                      (static_cast<std::uint64_t>(static_cast<std::uint32_t>(bu)) << 21) ^
-                      static_cast<std::uint64_t>(static_cast<std::uint32_t>(bv));
-    x += 0x9E3779B97F4A7C15ULL;
-    x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ULL;
-    x = (x ^ (x >> 27)) * 0x94D049BB133111EBULL;
-    x ^= x >> 31;
-    return static_cast<int>(x % static_cast<std::uint64_t>(stride * stride));
+    const std::uint64_t key = (static_cast<std::uint64_t>(static_cast<std::uint32_t>(view)) << 42) ^
+                              (static_cast<std::uint64_t>(static_cast<std::uint32_t>(bu)) << 21) ^
+                              static_cast<std::uint64_t>(static_cast<std::uint32_t>(bv));
+    return static_cast<int>(MixBits(key) % static_cast<std::uint64_t>(stride * stride));
 }
 
 }  // namespace

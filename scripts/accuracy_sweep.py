@@ -33,8 +33,8 @@ import subprocess
 import sys
 import tempfile
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-KEYS = ("length_m", "width_m", "height_m")
+from early_stop_study import HERE, KEYS, errors_mm
+
 DISC_RADIUS_M = 0.4  # the synthetic turntable's disc
 
 
@@ -125,9 +125,7 @@ def run_case(boxd, case):
     if result["status"] != "ok":
         out["reason"] = (result.get("reason") or {}).get("code", "")
         return out
-    # Rounded to the nanometre, so that an error equal to its bound (both written to the
-    # hundredth of a millimetre) is not pushed past it by the doubles' difference.
-    out["error_mm"] = [round(1000 * (result["dimensions"][k] - truth[k]), 6) for k in KEYS]
+    out["error_mm"] = errors_mm(result, truth)
     out["bound_mm"] = [1000 * result["uncertainty_m"][k] for k in KEYS]
     out["shape"] = result["shape"]
     return out

@@ -22,6 +22,13 @@ FLAT_FACES = 2.5  # kFlatFaces
 KEYS = ("length_m", "width_m", "height_m")
 
 
+def errors_mm(result, truth):
+    """Each dimension's error against `truth` in mm, rounded to the nanometre: the dimension and
+    the truth are written to the hundredth of a millimetre, and their difference in doubles may
+    pass an equal bound by 1e-17."""
+    return [round(1000 * (result["dimensions"][k] - truth[k]), 6) for k in KEYS]
+
+
 def synth_args(case, out, angles):
     a = ["synth", "--out", out, "--force", "--dims", *map(str, case["dims"]),
          "--noise", case["noise"], "--frames", str(case["frames"]), "--seed", str(case["seed"]),

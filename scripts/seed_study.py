@@ -22,7 +22,7 @@ import subprocess
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
 
-from early_stop_study import HERE, KEYS, synth_args
+from early_stop_study import HERE, KEYS, errors_mm, synth_args
 
 SPLIT = re.compile(r"uncertainty: faces ([\d.]+) ([\d.]+) ([\d.]+) mm, registration ([\d.]+) "
                    r"([\d.]+) mm, table ([\d.]+) mm")
@@ -48,9 +48,7 @@ def measure(boxd, case, seed, tmp, split):
         return seed, None, None, r.get("reason", {}).get("code")
     with open(os.path.join(out, "session.json")) as f:
         truth = json.load(f)["ground_truth"]
-    # Rounded to the nanometre: the dimension and the truth are written to the hundredth of a
-    # millimetre, and their difference in doubles may pass an equal bound by 1e-17.
-    err = [round((r["dimensions"][k] - truth[k]) * 1e3, 6) for k in KEYS]
+    err = errors_mm(r, truth)
     bound = [r["uncertainty_m"][k] * 1e3 for k in KEYS]
     parts = SPLIT.search(run.stderr) if split else None
     return seed, err, bound, parts.groups() if parts else ""

@@ -5,17 +5,11 @@
 #include <random>
 #include <thread>
 
+#include "pipeline/mix_bits.h"
+
 namespace boxd {
 
 namespace {
-
-// SplitMix64 finaliser (Steele, Lea, Flood 2014): decorrelates nearby seeds.
-std::uint64_t MixBits(std::uint64_t x) {
-    x += 0x9e3779b97f4a7c15ULL;
-    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-    return x ^ (x >> 31);
-}
 
 constexpr double kDegToRad = M_PI / 180.0;
 // Reported angles closer than this are the same pose.

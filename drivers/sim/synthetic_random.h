@@ -6,25 +6,18 @@
 #include <cmath>
 #include <cstdint>
 
-namespace boxd::synthetic_random {
+#include "pipeline/mix_bits.h"
 
-// Returns a well-mixed 64-bit value of `x` (the splitmix64 finaliser, Steele, Lea and Flood,
-// "Fast splittable pseudorandom number generators", OOPSLA 2014).
-inline std::uint64_t Mix(std::uint64_t x) {
-    x += 0x9e3779b97f4a7c15ULL;
-    x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
-    return x ^ (x >> 31);
-}
+namespace boxd::synthetic_random {
 
 // Returns the seed of the sub-stream `tag` of `seed` (e.g. one pose, one frame, one purpose).
 inline std::uint64_t Derive(std::uint64_t seed, std::uint64_t tag) {
-    return Mix(Mix(seed) ^ (tag * 0xd1b54a32d192ed03ULL + 0x8cb92ba72f3d8dd7ULL));
+    return MixBits(MixBits(seed) ^ (tag * 0xd1b54a32d192ed03ULL + 0x8cb92ba72f3d8dd7ULL));
 }
 
 // Returns the raw 64-bit draw number `index` of stream `seed`.
 inline std::uint64_t Bits(std::uint64_t seed, std::uint64_t index) {
-    return Mix(seed ^ Mix(index));
+    return MixBits(seed ^ MixBits(index));
 }
 
 // Returns a uniform number in [0, 1) (53 bits).
