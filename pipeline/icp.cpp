@@ -148,6 +148,7 @@ IcpResult AlignIcp(const OrientedPoints& source, const IcpTarget& target, const 
     if (fin.weight_sum > 0.0) {
         result.point_scatter = fin.jtj / fin.weight_sum;
         result.mean_height_m = fin.height_sum / fin.weight_sum;
+        result.random_displacement_m = std::sqrt(3.0 / fin.weight_sum) * result.rmse;
     }
     if (fin.solved < config.min_correspondences) result.converged = false;
     return result;

@@ -54,6 +54,12 @@ struct IcpResult {
     // min_correspondences the alignment never moved and `transform` is its start.
     int solved = 0;
     int iterations = 0;
+    // The RMS displacement along the target normals that the residuals' own scatter leaves in
+    // `transform`: the textbook covariance rmse² (JᵀJ)⁻¹ of independent residuals carried
+    // through `point_scatter`, tr(S (JᵀJ)⁻¹) rmse² = 3 rmse² / W over the W readings solved.
+    // Falls as 1 / √W: small beside what the views' samplings share for an alignment on whole
+    // faces, large for one on a few samples of a narrow strip.
+    double random_displacement_m = 0.0;
     // The weighted mean height of the upright correspondences: the height at which the in-plane
     // motion fits the data (see ReframedAlignment, view_registration.h).
     double mean_height_m = 0.0;

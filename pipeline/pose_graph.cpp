@@ -130,7 +130,7 @@ void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Problem
             e.loop_closure ? new ceres::HuberLoss(config.loop_huber_scale) : nullptr;
         const Eigen::Matrix3d info =
             e.point_scatter / (config.edge_displacement_sigma_m * config.edge_displacement_sigma_m);
-        Eigen::Matrix3d sqrt_info = SqrtInformation(info);
+        Eigen::Matrix3d sqrt_info = SqrtInformation(info) * std::sqrt(e.evidence_weight);
         for (int row = 0; row < 3; ++row) {
             sqrt_info.row(row) *= std::sqrt(e.row_weight(row)) / config.edge_part_scale[row];
         }

@@ -56,6 +56,12 @@ struct PoseEdge {
     // How much each residual row counts: 1, or less for a row that errs far beyond the scatter
     // of its kind (row_huber_scale; set by the weighed solve, pose_graph_variance.cpp).
     Eigen::Vector3d row_weight = Eigen::Vector3d::Ones();
+    // The RMS surface displacement the alignment's own residuals leave (IcpResult::
+    // random_displacement_m), and how much the edge counts for it: 1 where it is small beside
+    // the edges' shared floor, less where the alignment rests on too few samples to reach it
+    // (set by the weighed solve, pose_graph_variance.cpp).
+    double random_displacement_m = 0.0;
+    double evidence_weight = 1.0;
 };
 
 // Node k's pose maps view k's points into the frame of view 0 (held constant).

@@ -129,6 +129,20 @@ void ReweighRows(const Linearization& lin, const std::array<double, kGroups>& fa
     }
 }
 
+// Sets each kept edge's evidence weight for the edges' shared floor `floor_m` (the RMS surface
+// displacement of an edge whose own residuals leave next to nothing): an edge errs by that floor
+// and by what its own residuals leave, independently, so it counts as one over their summed
+// variances, floor² / (floor² + random²) of a floor-limited edge. An alignment on whole faces
+// leaves a few hundredths of a millimetre and counts fully; one that matched a few dozen
+// samples of a strip the two views share leaves tenths, as much as the floor or more.
+void WeighEvidence(double floor_m, std::vector<PoseEdge>& edges) {
+    const double f2 = floor_m * floor_m;
+    for (PoseEdge& e : edges) {
+        const double r2 = e.random_displacement_m * e.random_displacement_m;
+        e.evidence_weight = f2 > 0.0 ? f2 / (f2 + r2) : 1.0;
+    }
+}
+
 }  // namespace
 
 Eigen::MatrixXd PoseCovariance(const PoseGraph& graph, const PoseGraphConfig& config) {
@@ -182,6 +196,11 @@ Status SolveWeighedByTheData(PoseGraph& graph, const PoseGraphConfig& config) {
         weighed.prior_center_sigma_m *= std::sqrt(factor[kPriorTranslation]);
         weighed.prior_yaw_sigma_rad *= std::sqrt(factor[kPriorYaw]);
         ReweighRows(*lin, factor, config.row_huber_scale, graph.edges);
+        // The floor: the configured displacement sigma as the data have rescaled it, one scale
+        // for the three rows (their geometric mean).
+        const auto& s = weighed.edge_part_scale;
+        WeighEvidence(config.edge_displacement_sigma_m * std::cbrt(s[0] * s[1] * s[2]),
+                      graph.edges);
         if (Status s = SolvePoseGraph(graph, weighed); !s) return s;
     }
     return OkStatus();

@@ -132,6 +132,7 @@ PairAlignment AlignViewPair(int i, int j, const ViewClouds& view_j, const ViewTa
     edge.measured = out.fine.transform;
     edge.information = out.fine.information;
     edge.point_scatter = out.fine.point_scatter;
+    edge.random_displacement_m = out.fine.random_displacement_m;
     return out;
 }
 
@@ -160,9 +161,10 @@ std::vector<PoseEdge> AcceptedEdges(const std::vector<PairAlignment>& alignments
         ++st.attempted;
         const IcpResult& r = a.fine;
         spdlog::debug(
-            "registration: {}-{}: {}+{} iterations, fitness {:.2f}, rmse {:.2f} mm, "
+            "registration: {}-{}: {}+{} iterations, fitness {:.2f} ({} upright of {}), rmse {:.2f} mm, "
             "motion ({:.1f}, {:.1f}) mm {:.2f} deg",
-            a.edge.from, a.edge.to, a.coarse_iterations, r.iterations, r.fitness,
+            a.edge.from, a.edge.to, a.coarse_iterations, r.iterations, r.fitness, r.solved,
+            r.correspondences,
             r.rmse * 1000.0, r.transform.x * 1000.0, r.transform.y * 1000.0,
             r.transform.yaw * 180.0 / M_PI);
         // An alignment with too few upright correspondences never left its start: its

@@ -183,6 +183,48 @@ TEST(PoseCovariance, OneEdgeFarOffDoesNotWidenEveryPose) {
                 sigma[0] * 1e3, sigma[1] * 1e3);
 }
 
+// The largest difference in translation between the poses of two solved graphs of one ring,
+// each relative to its node 0 (as the graphs' frame is).
+double LargestPoseShift(const PoseGraph& a, const PoseGraph& b) {
+    double worst = 0.0;
+    for (std::size_t k = 1; k < a.poses.size(); ++k) {
+        const Se2 ra = a.poses[0].Inverse().Compose(a.poses[k]);
+        const Se2 rb = b.poses[0].Inverse().Compose(b.poses[k]);
+        worst = std::max(worst, Se2Difference(ra, rb).head<2>().norm());
+    }
+    return worst;
+}
+
+TEST(OptimizePoseGraph, AnEdgeOnFewSamplesCountsForWhatItsResidualsLeave) {
+    // Eight poses, as a narrow box 45 degrees apart; one alignment matched a few dozen samples
+    // of a strip the two views share and is 0.8 mm off (far within the rejection threshold).
+    // Against the graph without it: counted as much as its peers, it moves the poses; weighed
+    // by what its own residuals leave (0.9 mm, as 40 samples at 1 mm RMS do), it hardly does.
+    PoseGraphConfig config;
+    for (unsigned seed : {7u, 8u, 9u}) {
+        Ring ring = MakeRing(8, {0.003, 0.002}, seed, 0.0001);
+        for (PoseEdge& e : ring.graph.edges) e.random_displacement_m = 0.00002;
+        PoseGraph without = ring.graph;
+        without.edges.erase(without.edges.begin() + 3);
+        ASSERT_TRUE(OptimizePoseGraph(without, config).ok());
+        double shift[2];
+        for (int i = 0; i < 2; ++i) {
+            PoseGraph graph = ring.graph;
+            PoseEdge& weak = graph.edges[3];  // 1-3, two poses apart
+            ASSERT_EQ(weak.from, 1);
+            ASSERT_EQ(weak.to, 3);
+            weak.measured.x += 0.0008;
+            if (i == 1) weak.random_displacement_m = 0.0009;
+            ASSERT_TRUE(OptimizePoseGraph(graph, config).ok());
+            EXPECT_FALSE(weak.rejected);
+            shift[i] = LargestPoseShift(graph, without);
+        }
+        std::printf("seed %u: the poses move by %.3f mm with the edge counted fully, %.3f mm "
+                    "weighed by its evidence\n", seed, shift[0] * 1e3, shift[1] * 1e3);
+        EXPECT_LT(shift[1], 0.4 * shift[0]);
+    }
+}
+
 TEST(PoseCovariance, IsWithinAFactorOfTheTrueScatter) {
     // Many rings with the same noise: the covariance's sigma against the poses' actual errors.
     PoseGraphConfig config;
