@@ -40,30 +40,55 @@ struct FaceCells {
         // cell is a sample (the pooled spread is the spread of such samples), or a face's
         // middle, where a bulge crests, would go unjudged.
         std::unordered_map<std::size_t, CellStats> cells;
-        for (const auto& [key, st] : cell_view)
-            cells[key / static_cast<std::size_t>(views)].Add(st.Mean());
-        double pooled = 0.0;
-        int dof = 0, total = 0;
+        std::unordered_map<std::size_t, double> inverse_counts;  // per cell: Σ 1/r over views
+        for (const auto& [key, st] : cell_view) {
+            const std::size_t cell = key / static_cast<std::size_t>(views);
+            cells[cell].Add(st.Mean());
+            inverse_counts[cell] += 1.0 / st.n;
+        }
+        double pooled = 0.0, within = 0.0, inverse_sum = 0.0;
+        int dof = 0, total = 0, within_dof = 0, samples = 0;
         for (const auto& [cell, st] : cells) {
             if (st.n >= 2) {
                 pooled += st.sum_sq - st.sum * st.sum / st.n;
                 dof += st.n - 1;
+                inverse_sum += inverse_counts.at(cell);
+                samples += st.n;
             }
         }
-        for (const auto& [key, st] : cell_view) total += st.n;
+        for (const auto& [key, st] : cell_view) {
+            total += st.n;
+            if (st.n >= 2) {
+                within += st.sum_sq - st.sum * st.sum / st.n;
+                within_dof += st.n - 1;
+            }
+        }
         // Without a second view of any cell (one pose), the within-view noise of a cell's mean,
         // its readings counted as a tenth as many independent ones.
         const double spread = dof >= 10 ? std::sqrt(pooled / dof) : point_sigma;
+        // A view's mean of a cell errs by what the view shares over the face (its registration,
+        // its plane) and by its readings' noise over their count r: var = shared + noise / r.
+        // The pooled spread mixes views of many readings with views of one or two; a cell whose
+        // views read it with fewer than the face's usual count is known worse than the spread
+        // says, one read with more better. Both parts from the face: the readings' scatter
+        // within a view's cell, and what of the spread that leaves.
+        const double noise = within_dof >= 10 ? within / within_dof : 0.0;
+        const double shared =
+            samples > 0 ? std::max(0.0, spread * spread - noise * inverse_sum / samples) : 0.0;
         std::vector<Judged> judged;
         for (const auto& [cell, st] : cells) {
             if (st.n * 3 < config.min_cell_points && dof >= 10) continue;
             // A cell whose views scatter more than the face's do (an edge some views see at
             // grazing incidence, where the lateral noise throws readings off the face) is
             // known no better than its own scatter says.
-            const double own = st.n >= 2 ? st.StdError() * std::sqrt(st.n) : 0.0;
+            const double own = st.n >= 2 ? st.StdError() : 0.0;
+            const double modelled =
+                within_dof >= 10
+                    ? std::sqrt(shared / st.n + noise * inverse_counts.at(cell) / (st.n * st.n))
+                    : spread / std::sqrt(st.n);
             judged.push_back(
                 {cell, st,
-                 dof >= 10 ? std::max(spread, own) / std::sqrt(st.n)
+                 dof >= 10 ? std::max(modelled, own)
                            : spread / std::sqrt(std::max(1.0, total / 10.0 / cells.size()))});
         }
         // The plane's offset as each view sees it: their spread is the registration's and the

@@ -161,11 +161,10 @@ std::vector<PoseEdge> AcceptedEdges(const std::vector<PairAlignment>& alignments
         ++st.attempted;
         const IcpResult& r = a.fine;
         spdlog::debug(
-            "registration: {}-{}: {}+{} iterations, fitness {:.2f} ({} upright of {}), rmse {:.2f} mm, "
-            "motion ({:.1f}, {:.1f}) mm {:.2f} deg",
+            "registration: {}-{}: {}+{} iterations, fitness {:.2f} ({} upright of {}), "
+            "rmse {:.2f} mm, motion ({:.1f}, {:.1f}) mm {:.2f} deg",
             a.edge.from, a.edge.to, a.coarse_iterations, r.iterations, r.fitness, r.solved,
-            r.correspondences,
-            r.rmse * 1000.0, r.transform.x * 1000.0, r.transform.y * 1000.0,
+            r.correspondences, r.rmse * 1000.0, r.transform.x * 1000.0, r.transform.y * 1000.0,
             r.transform.yaw * 180.0 / M_PI);
         // An alignment with too few upright correspondences never left its start: its
         // "measurement" would only repeat the turntable model, as if confirming it.

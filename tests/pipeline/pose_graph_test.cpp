@@ -219,8 +219,10 @@ TEST(OptimizePoseGraph, AnEdgeOnFewSamplesCountsForWhatItsResidualsLeave) {
             EXPECT_FALSE(weak.rejected);
             shift[i] = LargestPoseShift(graph, without);
         }
-        std::printf("seed %u: the poses move by %.3f mm with the edge counted fully, %.3f mm "
-                    "weighed by its evidence\n", seed, shift[0] * 1e3, shift[1] * 1e3);
+        std::printf(
+            "seed %u: the poses move by %.3f mm with the edge counted fully, %.3f mm "
+            "weighed by its evidence\n",
+            seed, shift[0] * 1e3, shift[1] * 1e3);
         EXPECT_LT(shift[1], 0.4 * shift[0]);
     }
 }
