@@ -36,8 +36,9 @@ struct PoseGraphConfig {
     double max_edge_displacement_m = 0.002;
     int max_rejection_rounds = 20;
     // Rounds of re-solving with the edges and the prior weighed by their variance components
-    // (what their residuals show) instead of the sigmas above; 0 keeps the sigmas.
-    int variance_rounds = 2;
+    // (what their residuals show) instead of the sigmas above, at most: they stop when the
+    // poses settle (pose_graph_variance.cpp). 0 keeps the sigmas.
+    int variance_rounds = 8;
     int max_solver_iterations = 100;
 
     // Returns an error naming the first invalid field, or Ok.
