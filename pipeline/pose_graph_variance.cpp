@@ -67,15 +67,6 @@ Eigen::VectorXd Leverage(const Eigen::SparseMatrix<double, Eigen::RowMajor>& jac
 // centre: wobble, a loose parcel) and yaws (the table's angle error).
 enum Group { kEdgeAcross, kEdgeAlong, kEdgeYaw, kPriorTranslation, kPriorYaw, kGroups };
 
-// The covariance of nodes 1..n-1 by variance-component estimation (Förstner). Each group's rows
-// are scaled by its factor, its squared whitened residuals over its redundancy Σ (1 − h_ii) with
-// H = J (JᵀJ)⁻¹ Jᵀ — the share of the residuals' degrees of freedom that the group holds — and
-// the split repeated until it settles. A group with less than one degree of freedom keeps its
-// configured weight. The edges' rows are three groups, not one: a depth camera's ICP errs along
-// its line of sight by other amounts than across it, and in yaw by others again. With one
-// factor for the three, the reference box's poses erred by 0.6 of their sigma along the line
-// of sight (against their truth, 16 seeds of the synthetic station); with three, by 1.0.
-// `factors` (when given, starting at 1) is multiplied by each group's factors of the rounds.
 // Each row's group: edges and priors both come in threes.
 int GroupOf(const Linearization& lin, Eigen::Index r) {
     const int part = static_cast<int>(r % 3);
@@ -86,6 +77,16 @@ int GroupOf(const Linearization& lin, Eigen::Index r) {
 // last read it.
 using Redundancy = std::array<double, kGroups>;
 
+// The covariance of nodes 1..n-1 by variance-component estimation (Förstner). Each group's rows
+// are scaled by its factor, its squared whitened residuals over its redundancy Σ (1 − h_ii) with
+// H = J (JᵀJ)⁻¹ Jᵀ — the share of the residuals' degrees of freedom that the group holds — and
+// the split repeated until it settles. A group with less than one degree of freedom keeps its
+// configured weight. The edges' rows are three groups, not one: a depth camera's ICP errs along
+// its line of sight by other amounts than across it, and in yaw by others again. With one
+// factor for the three, the reference box's poses erred by 0.6 of their sigma along the line
+// of sight (against their truth, 16 seeds of the synthetic station); with three, by 1.0.
+// `factors` (when given, starting at 1) is multiplied by each group's factors of the rounds,
+// and `held` (when given) gets the groups' redundancies of the last round.
 std::optional<Eigen::MatrixXd> VarianceComponentCovariance(
     const Linearization& lin, std::array<double, kGroups>* factors = nullptr,
     Redundancy* held = nullptr) {
