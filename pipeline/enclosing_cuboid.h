@@ -12,7 +12,10 @@
 // outside the true surface (Bonferroni over the cells), so noise does not inflate the box, while
 // a real bulge, strap or label — many cells out by millimetres — does count.
 //   - Cuboids: the face fit of box_fit.h locates each face's plane with all its points (the
-//     precision of an ideal box); each face's excess is the largest cell bound outside that plane.
+//     precision of an ideal box); each face's excess is the largest cell bound outside that plane,
+//     or the crest of a face bowing out (bowed_face.h), or the reach of a band or patch of cells
+//     standing out together where no one of them is sure enough alone (a thin strap or label on
+//     a noisy sensor; face_windows.h), whichever is largest.
 //   - Other objects (tubes, bags, L-shapes, open flaps): the support function of the surface,
 //     h(φ) = the largest cell bound along direction φ over cells of the outer layer seen from φ,
 //     for φ every degree (then every 0.1 degree near the best); the footprint is the rectangle of

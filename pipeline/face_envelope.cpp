@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <unordered_map>
 #include <unordered_set>
+#include <utility>
 #include <vector>
 
 #include "pipeline/bowed_face.h"
+#include "pipeline/face_windows.h"
 #include "pipeline/student_t.h"
 #include "pipeline/surface_cells.h"
 
@@ -22,9 +24,16 @@ constexpr int kMinFlatnessCells = 10;
 struct FaceCells {
     int views = 1;
     int na = 1;                 // cells across the face's grid: a cell's key is row * na + column
+    int nb = 1;                 // cells up the face's grid
     double da = 1.0, db = 1.0;  // the cells' size across and up the face
     std::unordered_map<std::size_t, CellStats> cell_view;  // key cell * views + view
     std::vector<CellStats> view_plane;                     // per view: offsets near the plane
+
+    // A cell's column and row on the face's grid.
+    std::pair<int, int> ColumnRow(std::size_t cell) const {
+        return {static_cast<int>(cell % static_cast<std::size_t>(na)),
+                static_cast<int>(cell / static_cast<std::size_t>(na))};
+    }
 
     // A cell judged for standing out: its mean over the views' means and its standard error.
     struct Judged {
@@ -131,7 +140,34 @@ struct FaceCells {
             out.excess_m = bow->excess_m;
             out.excess_se_m = bow->se_m;
         }
+        if (dof >= 10) ReadPatches(judged, shared, config, &out);
         return out;
+    }
+
+    // A band or a patch wider than a cell (face_windows.h), where the views' spread is known:
+    // `shared` is the variance a view's mean of a cell shares with its other cells.
+    void ReadPatches(const std::vector<Judged>& judged, double shared, const EnvelopeConfig& config,
+                     FaceResult* out) const {
+        std::vector<GridCell> grid;
+        grid.reserve(judged.size());
+        for (const Judged& c : judged) {
+            const auto [col, row] = ColumnRow(c.key);
+            grid.push_back(
+                {col, row, c.st.Mean(), std::max(0.0, c.se * c.se - shared / c.st.n), c.st.n});
+        }
+        std::vector<ViewCell> readings;
+        readings.reserve(cell_view.size());
+        const auto nv = static_cast<std::size_t>(views);
+        for (const auto& [key, st] : cell_view) {
+            const auto [col, row] = ColumnRow(key / nv);
+            readings.push_back({col, row, static_cast<int>(key % nv), st.sum, st.n});
+        }
+        const auto patch = WindowStandingOut(grid, readings, views, na, nb, shared,
+                                             config.false_alarm, out->view_spread_m);
+        if (patch && patch->excess_m > out->excess_m) {
+            out->excess_m = patch->excess_m;
+            out->excess_se_m = patch->se_m;
+        }
     }
 
     // Detection: a cell stands out when its lower bound passes the plane, with the Bonferroni
@@ -213,6 +249,7 @@ std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& b
     }
     for (std::size_t f = 0; f < 5; ++f) {
         faces[f].na = grids[f].na;
+        faces[f].nb = grids[f].nb;
         faces[f].da = grids[f].da;
         faces[f].db = grids[f].db;
     }

@@ -14,7 +14,7 @@ namespace boxd::envelope {
 
 struct FaceResult {
     double excess_m = 0.0;
-    double excess_se_m = 0.0;    // standard error of the cell that set the excess
+    double excess_se_m = 0.0;    // standard error of the cell or window that set the excess
     double offset_se_m = 0.0;    // standard error of the face plane's offset, from the views
     double view_spread_m = 0.0;  // standard deviation of the plane's offset between the views
     // The face's cells (those two views or more saw) about its plane: the mean square of
