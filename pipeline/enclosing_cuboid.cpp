@@ -96,6 +96,8 @@ Status EnvelopeConfig::Validate() const {
     if (!(outward_band_m > 0.0)) return bad("outward_band_m", "must be > 0");
     if (directions < 18) return bad("directions", "must be >= 18");
     if (max_points < 1000) return bad("max_points", "must be >= 1000");
+    if (shape_points < 1000) return bad("shape_points", "must be >= 1000");
+    if (threads < 1 || threads > 64) return bad("threads", "must be in 1..64");
     if (!(layer_sigmas > 0.0)) return bad("layer_sigmas", "must be > 0");
     if (!(min_fill > 0.0 && min_fill <= 1.0)) return bad("min_fill", "in (0, 1]");
     if (!(fill_cell_m > 0.0 && fill_cell_m < 0.05)) return bad("fill_cell_m", "in (0, 0.05)");
@@ -115,9 +117,10 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     // about its plane, seen at about the object's distance.
     const double sigma = std::max(noise_sigma_m, 0.0005);
     if (views == 1) return envelope::SingleViewCuboid(cloud, sigma, config);
-    // The subsample of the surface above the table that the fill, the support function and a
-    // grazing top's height all read.
-    const envelope::Surface surface = envelope::SurfaceAbove(cloud, config);
+    // The subsamples of the surface above the table: what the support function and a grazing
+    // top's height read, and what the shape's figures (fill, top cover) read.
+    const envelope::Surface surface = envelope::SurfaceAbove(cloud, config.max_points, config);
+    const envelope::Surface shape = envelope::SurfaceAbove(cloud, config.shape_points, config);
     // Where no view saw a top (the box fit found too few readings on one), the top's cells hold
     // walls' ends only, spread up the walls with their rays' vertical share of the noise (a
     // fifth of the table's at a grazing top). A top some view saw has rims beside it, read with
@@ -168,8 +171,8 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
         const double s_v = std::hypot(face_sigma(2), face_sigma(3));
         c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u,
                      fit.top_observed ? face_sigma(4) : top_se};
-        c.fill = FillRatio(surface, c, config);
-        c.top_cover = TopCover(surface, c.height_m, config);
+        c.fill = FillRatio(shape, c, config);
+        c.top_cover = TopCover(shape, c.height_m, config);
         // A flat face stands where every view sees it, up to the views' registration; a curved
         // "face" (a tube's side) stands where each view's tangent is.
         double spread = 0.0;
@@ -196,8 +199,8 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     if (!c) return c;
     c->cuboid = false;
     c->max_relative_excess = face_excess;
-    c->fill = FillRatio(surface, *c, config);
-    c->top_cover = TopCover(surface, c->height_m, config);
+    c->fill = FillRatio(shape, *c, config);
+    c->top_cover = TopCover(shape, c->height_m, config);
     return c;
 }
 

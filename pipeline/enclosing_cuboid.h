@@ -43,7 +43,15 @@ struct EnvelopeConfig {
     double inward_band_sigmas = 3.0;  // a face's points lie from this far inside its plane ...
     double outward_band_m = 0.06;     // ... to this far outside it
     int directions = 180;             // footprint orientations over 180 degrees (irregular)
-    int max_points = 40000;           // the support function works on an even subsample
+    // The support function reads at most max_points readings (an even subsample beyond), where
+    // a 0.5 m object's 12 mm cells hold about a hundred each: a cap ten times smaller starved a
+    // curved side's crest on a noisy sensor, its cells too thin to be judged (README).
+    int max_points = 400000;
+    int threads = 2;                  // the support function's directions
+    // The footprint's fill and the top's cover read an even subsample of at most shape_points
+    // readings: their cells count as surface from fill_cell_points readings, a count set for
+    // that density (denser, the noise's scattered readings fill the cells round an L's notch).
+    int shape_points = 40000;
     double layer_sigmas = 5.0;        // a cell's outer layer: within this many σ of its extreme
     double min_z_m = 0.012;           // points lower than this are table, not footprint
     // Shape: the convex hull of a cuboid's footprint fills its rectangle to at least min_fill

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <utility>
 
+#include "pipeline/parallel_for.h"
 #include "pipeline/surface_cells.h"
 
 namespace boxd::envelope {
@@ -261,7 +262,13 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
 // direction (a box, an L), the area grows away from it by the sum of its sides squared per
 // radian, so the rectangles alike lie within 2 sigma_A / (lu² + lv²) of it, a step either way
 // at most; those are wider by the other side times the turn, which a noisy area may not show,
-// and the least rectangle stands alone.
+// and the least rectangle stands alone. It also stands alone where the areas grow away from it
+// at half that rate or more, their slope over the turn fitted over kTurnSteps directions either
+// way: an object whose footprint has corners. A direction's sigma_A is its chosen cells', and
+// on a noisy cloud a wall's end read above its readings' mean (HighEndSe) made it several
+// millimetres: areas two steps from an L's corner passed for alike, and its turned rectangles
+// read it 4 mm long. A rounded footprint (a bag, a tube) grows far slower than its corners'
+// rate near its least rectangle.
 struct Alike {
     int orientations = 1;
     double along_u = 0.0, along_v = 0.0;  // mean sides along the least rectangle's u and v
@@ -297,6 +304,22 @@ Alike AlikeRectangles(const std::vector<Support>& supports, int best) {
         ++count;
     }
     if (widest <= faceted + step) return {};
+    // The areas' growth per step away from the least, by least squares over the turn.
+    constexpr int kTurnSteps = 10;
+    double st = 0.0, sa = 0.0, stt = 0.0, sta = 0.0;
+    int points = 0;
+    for (int k = 1; k <= std::min(kTurnSteps, n / 4); ++k) {
+        for (int side : {-1, 1}) {
+            const double a = area(sides(((best + side * k) % n + n) % n)) - area(least);
+            st += k;
+            sa += a;
+            stt += k * k;
+            sta += k * a;
+            ++points;
+        }
+    }
+    const double growth = (sta - st * sa / points) / (stt - st * st / points);
+    if (growth >= 0.5 * (least[0] * least[0] + least[1] * least[1]) * step) return {};
     return {count, sum_u / count, sum_v / count};
 }
 
@@ -352,7 +375,7 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
     const int n = config.directions;
     std::vector<Support> coarse(static_cast<std::size_t>(n));
     std::vector<double> w(static_cast<std::size_t>(n));
-    for (int i = 0; i < n; ++i) w[i] = width(M_PI * i / n, &coarse[i]);
+    ParallelFor(n, config.threads, [&](int i) { w[i] = width(M_PI * i / n, &coarse[i]); });
     // An unseen side leaves the object unbounded there: a bulge or a flap could stand out
     // anywhere on it, and every rectangle would be a guess.
     if (std::any_of(w.begin(), w.end(), [](double x) { return !std::isfinite(x); })) {
@@ -366,15 +389,24 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
     double best_phi = M_PI * best / n, best_area = w[best] * w[(best + n / 2) % n];
     Support su = coarse[best], sv = coarse[(best + n / 2) % n];
     const auto alike = AlikeRectangles(coarse, best);
-    for (int j = -9; j <= 9 && alike.orientations == 1; ++j) {
-        const double phi = M_PI * best / n + j * (M_PI / n) / 10.0;
-        Support a, b;
-        const double area = width(phi, &a) * width(phi + M_PI / 2.0, &b);
-        if (area < best_area) {
-            best_area = area;
-            best_phi = phi;
-            su = a;
-            sv = b;
+    if (alike.orientations == 1) {
+        // Tenths of a step either way, each direction and the one square to it.
+        constexpr int kFine = 9;
+        std::vector<Support> fine(4 * kFine + 2);
+        std::vector<double> fine_w(fine.size());
+        auto phi_of = [&](int k) {
+            return M_PI * best / n + (k / 2 - kFine) * (M_PI / n) / 10.0 + (k % 2) * M_PI / 2.0;
+        };
+        ParallelFor(static_cast<int>(fine.size()), config.threads,
+                    [&](int k) { fine_w[k] = width(phi_of(k), &fine[k]); });
+        for (std::size_t k = 0; k < fine.size(); k += 2) {
+            const double area = fine_w[k] * fine_w[k + 1];
+            if (area < best_area) {
+                best_area = area;
+                best_phi = phi_of(static_cast<int>(k));
+                su = fine[k];
+                sv = fine[k + 1];
+            }
         }
     }
     if (!std::isfinite(best_area)) {

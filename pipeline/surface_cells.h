@@ -124,14 +124,15 @@ struct CellGrid {
     }
 };
 
-// An even subsample of the cloud above the table (at most config.max_points), and how far it
-// reaches from the axis and up, with a centimetre to spare.
+// An even subsample of the cloud above the table (at most `max_points`: config.max_points for
+// the support function, config.shape_points for the shape's figures), and how far it reaches
+// from the axis and up, with a centimetre to spare.
 struct Surface {
     std::vector<Eigen::Vector3f> points;
     double radius = 0.0, top = 0.0;
 };
 
-Surface SurfaceAbove(const FusedCloud& cloud, const EnvelopeConfig& config);
+Surface SurfaceAbove(const FusedCloud& cloud, int max_points, const EnvelopeConfig& config);
 
 // Returns the noise of a reading's height at `z_m` above the table's centre, from the noise of
 // the table top about its plane (`table_sigma_m`) and the camera's position (table frame). A

@@ -97,6 +97,7 @@ int RunBench(const BenchOptions& opt) {
     config.threads = opt.threads;
     config.registration.threads = opt.threads;
     config.box_fit.threads = opt.threads;
+    config.envelope.threads = opt.threads;
     std::vector<double> wall;
     std::map<std::string, std::vector<double>> stages;
     std::string status;

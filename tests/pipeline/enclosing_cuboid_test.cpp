@@ -347,6 +347,12 @@ TEST(EnvelopeConfig, ValidateNamesTheField) {
     c = EnvelopeConfig{};
     c.max_view_spread_rmse = std::nan("");
     expect_field(c, "max_view_spread_rmse");
+    c = EnvelopeConfig{};
+    c.threads = 0;
+    expect_field(c, "threads");
+    c = EnvelopeConfig{};
+    c.shape_points = 999;
+    expect_field(c, "shape_points");
 }
 
 }  // namespace
