@@ -6,7 +6,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tests/support/envelope_clouds.h"
@@ -329,30 +331,22 @@ TEST(EnvelopeConfig, ValidateNamesTheField) {
         EXPECT_NE(s.error().message.find("envelope." + field + ":"), std::string::npos)
             << s.error().message;
     };
-    EnvelopeConfig c;
-    c.cell_along_m = 0.0;
-    expect_field(c, "cell_along_m");
-    c = EnvelopeConfig{};
-    c.min_cell_points = 2;
-    expect_field(c, "min_cell_points");
-    c = EnvelopeConfig{};
-    c.false_alarm = 0.5;
-    expect_field(c, "false_alarm");
-    c = EnvelopeConfig{};
-    c.directions = 17;
-    expect_field(c, "directions");
-    c = EnvelopeConfig{};
-    c.min_fill = 1.1;
-    expect_field(c, "min_fill");
-    c = EnvelopeConfig{};
-    c.max_view_spread_rmse = std::nan("");
-    expect_field(c, "max_view_spread_rmse");
-    c = EnvelopeConfig{};
-    c.threads = 0;
-    expect_field(c, "threads");
-    c = EnvelopeConfig{};
-    c.shape_points = 999;
-    expect_field(c, "shape_points");
+    // Each field set just outside its range, alone.
+    const std::vector<std::pair<std::string, std::function<void(EnvelopeConfig&)>>> bad = {
+        {"cell_along_m", [](EnvelopeConfig& c) { c.cell_along_m = 0.0; }},
+        {"min_cell_points", [](EnvelopeConfig& c) { c.min_cell_points = 2; }},
+        {"false_alarm", [](EnvelopeConfig& c) { c.false_alarm = 0.5; }},
+        {"directions", [](EnvelopeConfig& c) { c.directions = 17; }},
+        {"min_fill", [](EnvelopeConfig& c) { c.min_fill = 1.1; }},
+        {"max_view_spread_rmse", [](EnvelopeConfig& c) { c.max_view_spread_rmse = std::nan(""); }},
+        {"threads", [](EnvelopeConfig& c) { c.threads = 0; }},
+        {"shape_points", [](EnvelopeConfig& c) { c.shape_points = 999; }},
+    };
+    for (const auto& [field, set] : bad) {
+        EnvelopeConfig c;
+        set(c);
+        expect_field(c, field);
+    }
 }
 
 }  // namespace
