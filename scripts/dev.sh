@@ -109,7 +109,7 @@ sanitize_build() {
 # cores. `scripts/dev.sh test` (CI) leaves them out of the sanitizer run; `sanitize` runs all.
 # The Debian package and the operator page in Chromium check packaging and a browser, not
 # boxd's memory: they run in the plain suite only.
-SANITIZE_SLOW='FocalScaleStation|CliCalibrate[.](Calibrates|RefusesWhenNoGeometry)|ServeCalibrationHistory|RecoversInjectedErrors.*seed1[23]|Accuracy[.]|DebianPackage[.]|OperatorPage[.]'
+SANITIZE_SLOW='FocalScaleStation|LShapesLeanOverSeeds|CliCalibrate[.](Calibrates|RefusesWhenNoGeometry)|ServeCalibrationHistory|RecoversInjectedErrors.*seed1[23]|Accuracy[.]|DebianPackage[.]|OperatorPage[.]'
 
 sanitize() {
     sanitize_build

@@ -5,12 +5,15 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "pipeline/student_t.h"
 #include "tests/support/envelope_clouds.h"
 #include "tests/support/expect_error.h"
 
@@ -243,6 +246,42 @@ TEST(FitEnclosingCuboid, LShapeIsIrregularAtTwoAndAHalfMillimetresOfNoise) {
     // limit of irregular shapes on noisy clouds (README, accuracy), held here to 3.5 mm.
     EXPECT_NEAR(f.cuboid->length_m, l, 0.0035);
     EXPECT_NEAR(f.cuboid->width_m, w, 0.0035);
+}
+
+TEST(FitEnclosingCuboid, LShapesLeanOverSeedsStaysWithinTheIrregularTolerance) {
+    // The support function reads this hand-made L's flat faces outside themselves by about half
+    // a millimetre (README, Known limits), more on every reading than on the 40,000 of the shape's
+    // figures: printed over 20 seeds on both. Each dimension must stay within the irregular
+    // shapes' 3 mm (at 2.5 mm of noise the turned rectangles' averaging read one L 4-6 mm large:
+    // LShapeIsIrregularAtTwoAndAHalfMillimetresOfNoise).
+    const double l = 0.40, w = 0.30, h = 0.20, sigma = 0.0015;
+    const std::vector<Block> blocks = {{-l / 2, l / 2, -w / 2, 0.0, h},
+                                       {-l / 2, 0.0, 0.0, w / 2, h}};
+    EnvelopeConfig subsample;
+    subsample.max_points = subsample.shape_points;
+    for (const EnvelopeConfig& config : {EnvelopeConfig{}, subsample}) {
+        double sum[3] = {0.0, 0.0, 0.0}, largest = 0.0;
+        int heights_within = 0;  // within the cloud's own 95% bound (no registration share)
+        const int seeds = 20;
+        for (unsigned seed = 10; seed < 10 + seeds; ++seed) {
+            const FusedCloud cloud = SampleBlocks(blocks, 0.0, 0.7, {-0.01, 0.0}, seed, sigma);
+            const Result<BoxFit> box = FitFootprintBox(cloud.points, BoxFitConfig{});
+            const auto c = FitEnclosingCuboid(cloud, box, kViews, 0.001, sigma, kOverhead, config);
+            ASSERT_TRUE(c.ok()) << c.error().message;
+            const double err[3] = {c->length_m - l, c->width_m - w, c->height_m - h};
+            for (int k = 0; k < 3; ++k) {
+                EXPECT_LT(std::abs(err[k]), 0.003) << "seed " << seed << " dimension " << k;
+                sum[k] += err[k] / seeds;
+                largest = std::max(largest, std::abs(err[k]));
+            }
+            heights_within += std::abs(err[2]) <= kNormal95 * c->sigma_m[2] ? 1 : 0;
+        }
+        std::printf(
+            "L on %d readings at most: mean error %+.2f / %+.2f / %+.2f mm, largest %.2f mm, "
+            "heights within bound %d of %d\n",
+            config.max_points, sum[0] * 1e3, sum[1] * 1e3, sum[2] * 1e3, largest * 1e3,
+            heights_within, seeds);
+    }
 }
 
 TEST(FitEnclosingCuboid, ThinCloudIsInsufficientDataWithoutABox) {
