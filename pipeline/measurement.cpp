@@ -5,6 +5,8 @@
 #include <ctime>
 #include <nlohmann/json.hpp>
 
+#include "pipeline/student_t.h"
+
 namespace boxd {
 
 using nlohmann::json;
@@ -19,11 +21,15 @@ double Round(double v, double step) {
     return std::round(v * scale) / scale;
 }
 
-// A bound rounded as the value it bounds is: up to `step`, after adding the half step by which
-// the rounded value itself may be off.
+// A bound as the value it bounds is written: that value is off what was measured by up to half
+// a `step`, uniformly and independently of the measurement's own error, so the rounding's share
+// of a 95% bound (1.96 standard deviations of a uniform half step: 1.96 step / sqrt(12)) adds in
+// quadrature, not in full; the sum is rounded up to the step, never below what it bounds.
 double RoundBound(double v, double step) {
     const double scale = std::round(1.0 / step);
-    return std::ceil(v * scale + 0.5 - 1e-9) / scale;
+    const double rounding = kNormal95 / std::sqrt(12.0);  // in steps
+    const double steps = v * scale;
+    return std::ceil(std::sqrt(steps * steps + rounding * rounding) - 1e-9) / scale;
 }
 
 json Array3(const std::array<double, 3>& a, double step) {

@@ -27,18 +27,19 @@ TEST(MeasurementJson, ValuesAreRoundedToTheHundredthOfAMillimetre) {
     EXPECT_DOUBLE_EQ(Written(0.4000451, 0.0001)["dimensions"]["length_m"].get<double>(), 0.40005);
 }
 
-TEST(MeasurementJson, BoundsAreRoundedUpAndHoldTheValuesOwnRounding) {
-    // The value written may be half a hundredth of a millimetre off what was measured, so a
-    // bound holds that half step too and is rounded up: never below what it bounds.
+TEST(MeasurementJson, BoundsHoldTheValuesOwnRoundingInQuadratureAndAreRoundedUp) {
+    // The value written may be up to half a hundredth of a millimetre off what was measured,
+    // uniformly: 1.96 / sqrt(12) of a hundredth at 95%, added in quadrature, then rounded up.
     const struct {
         double bound, written;
-    } cases[] = {{0.0, 0.00001},       {0.000004, 0.00001}, {0.000005, 0.00001},
-                 {0.0000051, 0.00002}, {0.000123, 0.00013}, {0.0001249, 0.00013},
-                 {0.0001251, 0.00014}, {0.0021, 0.00211}};
+    } cases[] = {{0.0, 0.00001},       {0.000004, 0.00001}, {0.0000051, 0.00001},
+                 {0.0000099, 0.00002}, {0.000123, 0.00013}, {0.0001251, 0.00013},
+                 {0.0001299, 0.00014}, {0.00013, 0.00014},  {0.0021, 0.00211}};
     for (const auto& c : cases) {
         const nlohmann::json u = Written(0.4, c.bound)["uncertainty_m"];
         for (const char* key : {"length_m", "width_m", "height_m"}) {
             EXPECT_DOUBLE_EQ(u[key].get<double>(), c.written) << c.bound << " " << key;
+            EXPECT_GE(u[key].get<double>(), c.bound) << "a bound is never written below itself";
         }
     }
 }
