@@ -95,7 +95,8 @@ Result<InitialEstimate> EstimateInitial(const Session& session, const MeasureCon
     for (std::size_t k = 0; k < view_points.size(); ++k) {
         view_points[k] = std::move(views.views[k].fusion_points);
     }
-    const FusedFit fit = FuseAndFit(view_points, registered->poses, mc.fusion, mc.box_fit, nullptr);
+    const FusedFit fit = FuseAndFit(view_points, registered->poses, mc.fusion, mc.box_fit, nullptr,
+                                    table->camera_to_table.translation().cast<float>());
     if (auto why = CheckFusedFit(fit, mc.refusal)) return AsCalibrationRefusal(*why);
 
     // Move the origin to the centre: registered motions become rotations about the origin.

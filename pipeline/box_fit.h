@@ -6,6 +6,8 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdint>
+#include <vector>
 
 #include "pipeline/measurement.h"
 #include "pipeline/point_cloud.h"
@@ -44,6 +46,16 @@ struct BoxFit {
     bool top_observed = true;
 };
 
+// Where a fit's readings were seen from: each reading's view and each view's camera, in the
+// readings' frame. A reading's noise lies along its ray; which face a reading counts for, and
+// whether it lies clear of that face's edges, is read where its ray meets the face's plane.
+struct ReadingRays {
+    const std::vector<std::uint16_t>* view = nullptr;      // per reading
+    const std::vector<Eigen::Vector3f>* cameras = nullptr;  // per view
+    // True when every one of `readings` readings names a view with a camera.
+    bool Covers(std::size_t readings) const;
+};
+
 // Returns the footprint box of `points` (table frame, object only): minimal-area rectangle seed,
 // then least-squares fits of the four side faces (sharing one yaw) and the top face.
 // OBJECT_TOO_SMALL / INSUFFICIENT_DATA errors when the cloud cannot support a box.
@@ -51,9 +63,10 @@ Result<BoxFit> FitFootprintBox(const Points& points, const BoxFitConfig& config)
 
 // The same, seeded from `seed_points` (the minimal-area rectangle and the starting height) and
 // fitted to `points`: the seed takes extremes and wants a cloud without stray readings, while
-// the face fits trim their own outliers and want every reading of a face (fusion.h).
+// the face fits trim their own outliers and want every reading of a face (fusion.h). With
+// `rays` covering `points`, a face's readings are chosen by their rays (ReadingRays).
 Result<BoxFit> FitFootprintBox(const Points& seed_points, const Points& points,
-                               const BoxFitConfig& config);
+                               const BoxFitConfig& config, const ReadingRays& rays = {});
 
 // Returns the PCA oriented bounding box of `points`: principal axes of the footprint in the table
 // plane plus the table normal (the object rests on the table), extents from the table top.

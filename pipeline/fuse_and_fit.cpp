@@ -5,11 +5,13 @@
 namespace boxd {
 
 FusedFit FuseAndFit(const std::vector<Points>& view_points, const std::vector<Se2>& poses,
-                    const FusionConfig& fusion, const BoxFitConfig& box_fit, StageLaps* laps) {
+                    const FusionConfig& fusion, const BoxFitConfig& box_fit, StageLaps* laps,
+                    const std::optional<Eigen::Vector3f>& camera) {
     FusedFit out;
-    out.fused = FuseViews(view_points, poses, fusion);
+    out.fused = FuseViews(view_points, poses, fusion, camera);
     if (laps) laps->Lap("fusion");
-    out.box = FitFootprintBox(out.fused.points, out.fused.unfiltered, box_fit);
+    out.box = FitFootprintBox(out.fused.points, out.fused.unfiltered, box_fit,
+                              ReadingRays{&out.fused.unfiltered_view, &out.fused.cameras});
     out.pca = FitPcaBox(out.fused.points);
     if (laps) laps->Lap("fit");
     if (!out.box) spdlog::debug("box fit: {}", out.box.error().message);

@@ -20,8 +20,10 @@ struct FusedFit {
 };
 
 // Returns the fusion of `view_points` (per view, its own frame) moved by `poses`, and the fits.
-// Laps "fusion" and "fit" on `laps` when given.
+// Laps "fusion" and "fit" on `laps` when given. `camera`: the camera in the views' own frame,
+// when known (the face fits then choose readings by their rays).
 FusedFit FuseAndFit(const std::vector<Points>& view_points, const std::vector<Se2>& poses,
-                    const FusionConfig& fusion, const BoxFitConfig& box_fit, StageLaps* laps);
+                    const FusionConfig& fusion, const BoxFitConfig& box_fit, StageLaps* laps,
+                    const std::optional<Eigen::Vector3f>& camera = std::nullopt);
 
 }  // namespace boxd

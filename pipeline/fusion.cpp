@@ -24,7 +24,7 @@ Status FusionConfig::Validate() const {
 }
 
 FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& poses,
-                     const FusionConfig& config) {
+                     const FusionConfig& config, const std::optional<Eigen::Vector3f>& camera) {
     FusedCloud all;
     std::size_t total = 0;
     for (const Points& v : views) total += v.size();
@@ -61,6 +61,10 @@ FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& p
         out.view.push_back(all.view[i]);
     }
     out.unfiltered = std::move(all.points);
+    out.unfiltered_view = std::move(all.view);
+    if (camera) {
+        for (std::size_t k = 0; k < views.size(); ++k) out.cameras.push_back(Se2Map(poses[k])(*camera));
+    }
     return out;
 }
 

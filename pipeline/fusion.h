@@ -3,6 +3,7 @@
 // view-consistency check.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "pipeline/box_fit.h"
@@ -36,6 +37,10 @@ struct FusedCloud {
     // face fits trim their own outliers, so they read these instead (their seed, which takes
     // extremes, still reads `points`).
     Points unfiltered;
+    std::vector<std::uint16_t> unfiltered_view;  // source view of each of `unfiltered`
+    // Each view's camera in this frame, where the views' own frame gave one (else empty): the
+    // face fits read a reading's margins along its ray (box_fit.h, ReadingRays).
+    std::vector<Eigen::Vector3f> cameras;
 };
 
 struct ConsistencyReport {
@@ -46,8 +51,10 @@ struct ConsistencyReport {
 };
 
 // Returns the union of `views` moved by `poses`, without the points of sparsely supported voxels.
+// `camera`: where the camera stands in the views' own frame, when known.
 FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& poses,
-                     const FusionConfig& config);
+                     const FusionConfig& config,
+                     const std::optional<Eigen::Vector3f>& camera = std::nullopt);
 
 // Returns, per view, whether its points agree with the fitted box.
 ConsistencyReport CheckViewConsistency(const FusedCloud& cloud, int num_views, const BoxFit& box,

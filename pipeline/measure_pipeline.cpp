@@ -108,8 +108,8 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream,
         view_points[k] =
             n == 1 ? std::move(views.views[k].points) : std::move(views.views[k].fusion_points);
     }
-    FusedFit fit =
-        FuseAndFit(view_points, registered->poses, config.fusion, config.box_fit, &m.laps);
+    FusedFit fit = FuseAndFit(view_points, registered->poses, config.fusion, config.box_fit,
+                              &m.laps, table.camera_to_table.translation().cast<float>());
     quality.points = static_cast<long>(fit.fused.points.size());
     if (auto why = CheckSingleObject(fit.fused, refuse)) {
         m.out.cloud = std::move(fit.fused.points);

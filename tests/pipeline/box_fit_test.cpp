@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <random>
+#include <vector>
 
 namespace boxd {
 namespace {
@@ -105,6 +108,63 @@ TEST(DistanceToBoxSurface, InsideOutsideAndOnFaces) {
     EXPECT_NEAR(DistanceToBoxSurface(box, {0.0f, 0.0f, 0.12f}), 0.02, 1e-6);
     EXPECT_NEAR(DistanceToBoxSurface(box, {0.0f, 0.0f, 0.05f}), 0.05, 1e-6);
     EXPECT_NEAR(DistanceToBoxSurface(box, {0.23f, 0.14f, 0.05f}), 0.05, 1e-6);
+}
+
+// Appends to `out` the top and the sides of an axis-aligned l x w x h box at the origin as a
+// camera at `camera` sees them (the faces turned towards it), every reading moved along its ray by noise
+// that grows with the square of its range, as a depth camera's does.
+void SampleAlongRays(double l, double w, double h, const Eigen::Vector3d& camera, double sigma_1m,
+                     unsigned seed, std::uint16_t camera_view, Points* out,
+                     std::vector<std::uint16_t>* view) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> unit(0.0, 1.0);
+    auto read = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& normal) {
+        if (normal.dot(camera - p) <= 0.0) return;  // faces away from the camera
+        const Eigen::Vector3d ray = p - camera;
+        const double range = ray.norm();
+        out->push_back((p + sigma_1m * range * range * unit(rng) * ray / range).cast<float>());
+        view->push_back(camera_view);
+    };
+    const double step = 0.002;
+    for (double u = -l / 2; u <= l / 2; u += step) {
+        for (double v = -w / 2; v <= w / 2; v += step) read({u, v, h}, Eigen::Vector3d::UnitZ());
+    }
+    for (double z = step / 2; z < h; z += step) {
+        for (double v = -w / 2; v <= w / 2; v += step) {
+            read({l / 2, v, z}, Eigen::Vector3d::UnitX());
+            read({-l / 2, v, z}, -Eigen::Vector3d::UnitX());
+        }
+        for (double u = -l / 2; u <= l / 2; u += step) {
+            read({u, w / 2, z}, Eigen::Vector3d::UnitY());
+            read({u, -w / 2, z}, -Eigen::Vector3d::UnitY());
+        }
+    }
+}
+
+TEST(FitFootprintBox, ChoosesAFacesReadingsByTheirRaysNotTheirNoisyPositions) {
+    // Two cameras 1.1 m away and 0.6 m above a 0.3 m box's top see it at about 60 degrees. A
+    // reading's noise moves it along its ray, across the top's margins as well as off its plane:
+    // margins read at the readings' positions keep one sign of the noise at each end, in unequal
+    // numbers, and the top moves; read where the rays meet the plane, they keep none.
+    const std::vector<Eigen::Vector3f> cameras = {{0.3f, -1.05f, 0.9f}, {-1.05f, 0.3f, 0.9f}};
+    Points pts;
+    std::vector<std::uint16_t> view;
+    for (std::uint16_t k = 0; k < 2; ++k) {
+        SampleAlongRays(0.40, 0.30, 0.30, cameras[k].cast<double>(), 0.008, 7 + k, k, &pts, &view);
+    }
+    const auto by_position = FitFootprintBox(pts, pts, BoxFitConfig{});
+    const auto by_ray = FitFootprintBox(pts, pts, BoxFitConfig{}, ReadingRays{&view, &cameras});
+    ASSERT_TRUE(by_position.ok()) << by_position.error().message;
+    ASSERT_TRUE(by_ray.ok()) << by_ray.error().message;
+    std::printf("height error: by position %+.4f mm, by ray %+.4f mm\n",
+                (by_position->height_m - 0.30) * 1e3, (by_ray->height_m - 0.30) * 1e3);
+    EXPECT_LT(std::abs(by_ray->height_m - 0.30), 0.2 * std::abs(by_position->height_m - 0.30));
+    // Rays that do not cover the readings are not used.
+    const std::vector<std::uint16_t> short_view(view.begin(), view.end() - 1);
+    const auto uncovered =
+        FitFootprintBox(pts, pts, BoxFitConfig{}, ReadingRays{&short_view, &cameras});
+    ASSERT_TRUE(uncovered.ok());
+    EXPECT_EQ(uncovered->height_m, by_position->height_m);
 }
 
 }  // namespace
