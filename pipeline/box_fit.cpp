@@ -359,8 +359,8 @@ Result<BoxFit> FitFootprintBox(const Points& seed_points, const Points& points,
             std::clamp(config.band_sigmas * s.sigma[4], config.min_band_m, config.initial_band_m);
     }
     if (top_observed && !FitTop(points, config, by_ray, top_band, s, counts)) {
-            top_observed = false;
-        }
+        top_observed = false;
+    }
     BoxFit fit;
     fit.top_observed = top_observed;
     const double len_u = s.d[0] + s.d[1], len_v = s.d[2] + s.d[3];

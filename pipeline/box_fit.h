@@ -50,7 +50,7 @@ struct BoxFit {
 // readings' frame. A reading's noise lies along its ray; which face a reading counts for, and
 // whether it lies clear of that face's edges, is read where its ray meets the face's plane.
 struct ReadingRays {
-    const std::vector<std::uint16_t>* view = nullptr;      // per reading
+    const std::vector<std::uint16_t>* view = nullptr;       // per reading
     const std::vector<Eigen::Vector3f>* cameras = nullptr;  // per view
     // True when every one of `readings` readings names a view with a camera.
     bool Covers(std::size_t readings) const;

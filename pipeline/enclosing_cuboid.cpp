@@ -106,6 +106,9 @@ Status EnvelopeConfig::Validate() const {
     if (!(top_band > 0.0 && top_band < 1.0)) return bad("top_band", "in (0, 1)");
     if (!(min_top_cover > 0.0 && min_top_cover <= 1.0)) return bad("min_top_cover", "in (0, 1]");
     if (!(max_view_spread_rmse > 0.0)) return bad("max_view_spread_rmse", "must be > 0");
+    if (!(max_incidence_deg > 0.0 && max_incidence_deg < 90.0)) {
+        return bad("max_incidence_deg", "must be in (0, 90)");
+    }
     return OkStatus();
 }
 

@@ -71,6 +71,10 @@ struct EnvelopeConfig {
     // ... and each face stands where all views see it: their offsets spread by no more than
     // this many times the registration's RMSE (a tube's side is where each view's tangent is).
     double max_view_spread_rmse = 3.0;
+    // A side faced by no view beyond this incidence (its normal against the ray to the camera)
+    // is taken as unseen: a depth camera returns next to nothing there (SPEC section 7: dropouts
+    // above about 75 degrees).
+    double max_incidence_deg = 75.0;
 
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;

@@ -63,7 +63,9 @@ FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& p
     out.unfiltered = std::move(all.points);
     out.unfiltered_view = std::move(all.view);
     if (camera) {
-        for (std::size_t k = 0; k < views.size(); ++k) out.cameras.push_back(Se2Map(poses[k])(*camera));
+        for (std::size_t k = 0; k < views.size(); ++k) {
+            out.cameras.push_back(Se2Map(poses[k])(*camera));
+        }
     }
     return out;
 }

@@ -195,6 +195,7 @@ Surface SurfaceAbove(const FusedCloud& cloud, int max_points, const EnvelopeConf
     }
     out.radius += 0.01;
     out.top += 0.01;
+    out.cameras = cloud.cameras;
     return out;
 }
 

@@ -130,6 +130,7 @@ struct CellGrid {
 struct Surface {
     std::vector<Eigen::Vector3f> points;
     double radius = 0.0, top = 0.0;
+    std::vector<Eigen::Vector3f> cameras;  // the views' cameras (FusedCloud::cameras), or none
 };
 
 Surface SurfaceAbove(const FusedCloud& cloud, int max_points, const EnvelopeConfig& config);

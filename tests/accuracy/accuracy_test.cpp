@@ -29,11 +29,13 @@ constexpr double kWrittenSlackM = 1e-9;
 
 struct Outcome {
     std::string name;
-    std::string group;   // box, parcel, tube, irregular, few poses, refusal
-    std::string expect;  // the refusal code a refusal case must give
+    std::string group;           // box, parcel, tube, irregular, few poses, refusal
+    std::string expect;          // the refusal code a refusal case must give
+    std::string expect_message;  // ... and words its message must hold, if any
     std::string shape;
     std::string status;
     std::string reason;
+    std::string message;  // the refusal's message
     double tol = 0.0;
     double err[3] = {NAN, NAN, NAN};          // length, width, height (measured - true), metres
     double uncertainty[3] = {NAN, NAN, NAN};  // the reported 95% bounds, metres
@@ -79,6 +81,7 @@ Outcome RunCase(const json& c) {
     o.tol = c.value("tol_m", 0.0);
     o.group = c.value("group", "box");
     o.expect = c.value("expect", "");
+    o.expect_message = c.value("expect_message", "");
     test::TempDir dir;
     const std::string session = (dir / "session").string();
     const auto synth = test::RunBoxd(SynthArgs(c, session));
@@ -97,7 +100,10 @@ Outcome RunCase(const json& c) {
         return o;
     }
     o.status = j["status"].get<std::string>();
-    if (j["reason"].is_object()) o.reason = j["reason"]["code"].get<std::string>();
+    if (j["reason"].is_object()) {
+        o.reason = j["reason"]["code"].get<std::string>();
+        o.message = j["reason"].value("message", "");
+    }
     if (j["timing_ms"].contains("processing")) {
         o.processing_ms = j["timing_ms"]["processing"].get<double>();
     }
@@ -194,6 +200,8 @@ TEST(Accuracy, SyntheticSuiteWithinTolerance) {
         if (!o.expect.empty()) {
             EXPECT_EQ(o.status, "no_dim") << o.name;
             EXPECT_EQ(o.reason, o.expect) << o.name;
+            EXPECT_NE(o.message.find(o.expect_message), std::string::npos)
+                << o.name << ": " << o.message;
             continue;
         }
         EXPECT_EQ(o.status, "ok") << o.name << ": " << o.reason;

@@ -111,8 +111,8 @@ TEST(DistanceToBoxSurface, InsideOutsideAndOnFaces) {
 }
 
 // Appends to `out` the top and the sides of an axis-aligned l x w x h box at the origin as a
-// camera at `camera` sees them (the faces turned towards it), every reading moved along its ray by noise
-// that grows with the square of its range, as a depth camera's does.
+// camera at `camera` sees them (the faces turned towards it), every reading moved along its ray by
+// noise that grows with the square of its range, as a depth camera's does.
 void SampleAlongRays(double l, double w, double h, const Eigen::Vector3d& camera, double sigma_1m,
                      unsigned seed, std::uint16_t camera_view, Points* out,
                      std::vector<std::uint16_t>* view) {

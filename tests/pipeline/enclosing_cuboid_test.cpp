@@ -378,6 +378,7 @@ TEST(EnvelopeConfig, ValidateNamesTheField) {
         {"directions", [](EnvelopeConfig& c) { c.directions = 17; }},
         {"min_fill", [](EnvelopeConfig& c) { c.min_fill = 1.1; }},
         {"max_view_spread_rmse", [](EnvelopeConfig& c) { c.max_view_spread_rmse = std::nan(""); }},
+        {"max_incidence_deg", [](EnvelopeConfig& c) { c.max_incidence_deg = 90.0; }},
         {"threads", [](EnvelopeConfig& c) { c.threads = 0; }},
         {"shape_points", [](EnvelopeConfig& c) { c.shape_points = 999; }},
     };
