@@ -5,9 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <opencv2/imgproc.hpp>
-#include <optional>
 #include <vector>
 
+#include "pipeline/face_choice.h"
 #include "pipeline/key_index.h"
 #include "pipeline/median.h"
 #include "pipeline/parallel_for.h"
@@ -102,41 +102,6 @@ Result<BoxState> SeedFootprint(const Points& points, const BoxFitConfig& config)
 struct FacePoint {
     int face;
     Eigen::Vector2d xy;
-};
-
-// Which readings a face fit takes. Axial noise moves a reading along its ray, so where a face is
-// seen obliquely it moves the reading along the face as much as across it: a margin from the
-// face's edges read at the reading's position keeps, at each end of the face, the readings their
-// noise moved inwards, and with them one sign of the noise across the face, one sign at the near
-// end, the other at the far end, in unequal numbers. The face moves: a tall box's top seen in one
-// Kinect frame a pose read 0.055 mm low on average (8 seeds), 0.009 mm chosen by rays. Where the
-// reading's ray meets the face's plane carries none of its depth's noise: the margins are read
-// there. Which face a reading belongs to is still read at its position, against a third of the
-// margin, well clear of the readings the margin keeps.
-class FaceChoice {
-public:
-    FaceChoice(const ReadingRays* rays, double margin)
-        : rays_(rays), margin_(margin), gate_(rays ? margin / 3.0 : margin) {}
-
-    double margin() const { return margin_; }
-    // How far inside a face's edges a reading must lie, at its position.
-    double gate() const { return gate_; }
-    // Where reading `i` is judged against the margin: where its ray meets the plane of unit
-    // normal `normal` at offset `offset`, or the reading itself without rays; none when its ray
-    // runs along the plane.
-    std::optional<Eigen::Vector3d> Judged(std::size_t i, const Eigen::Vector3f& reading,
-                                          const Eigen::Vector3d& normal, double offset) const {
-        const Eigen::Vector3d q = reading.cast<double>();
-        if (!rays_) return q;
-        const Eigen::Vector3d c = (*rays_->cameras)[(*rays_->view)[i]].cast<double>();
-        const double along = normal.dot(q - c);
-        if (std::abs(along) < 1e-9) return std::nullopt;
-        return c + (offset - normal.dot(c)) / along * (q - c);
-    }
-
-private:
-    const ReadingRays* rays_;
-    double margin_, gate_;
 };
 
 // One pass of the side-face fit: selects the points in each face's band (away from the edges),
@@ -301,12 +266,6 @@ Status BoxFitConfig::Validate() const {
     if (min_face_points < 3) return Bad("min_face_points", "must be >= 3");
     if (threads < 1 || threads > 64) return Bad("threads", "must be in 1..64");
     return OkStatus();
-}
-
-bool ReadingRays::Covers(std::size_t readings) const {
-    if (!view || !cameras || view->size() != readings) return false;
-    return std::all_of(view->begin(), view->end(),
-                       [&](std::uint16_t v) { return v < cameras->size(); });
 }
 
 Result<BoxFit> FitFootprintBox(const Points& points, const BoxFitConfig& config) {

@@ -6,9 +6,8 @@
 
 #include <Eigen/Core>
 #include <array>
-#include <cstdint>
-#include <vector>
 
+#include "pipeline/face_choice.h"
 #include "pipeline/measurement.h"
 #include "pipeline/point_cloud.h"
 #include "pipeline/result.h"
@@ -44,16 +43,6 @@ struct BoxFit {
     // False when the top had too few readings to fit (seen at grazing incidence): height_m is
     // then only the highest readings', and the sides' own ends say more (enclosing_cuboid.h).
     bool top_observed = true;
-};
-
-// Where a fit's readings were seen from: each reading's view and each view's camera, in the
-// readings' frame. A reading's noise lies along its ray; which face a reading counts for, and
-// whether it lies clear of that face's edges, is read where its ray meets the face's plane.
-struct ReadingRays {
-    const std::vector<std::uint16_t>* view = nullptr;       // per reading
-    const std::vector<Eigen::Vector3f>* cameras = nullptr;  // per view
-    // True when every one of `readings` readings names a view with a camera.
-    bool Covers(std::size_t readings) const;
 };
 
 // Returns the footprint box of `points` (table frame, object only): minimal-area rectangle seed,
