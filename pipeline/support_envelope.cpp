@@ -110,7 +110,9 @@ void KeepGapsOnly(const CellGrid<LayerCell>& fine, CellGrid<LayerCell>& coarse,
 // panel's corner at its hinge, 2-3 mm out over a millimetre or two of height) shares its row
 // with the side below it, which holds most of the readings and takes the layer's mean; half a
 // row holds it apart. Their cells hold half the readings, and the noise correction and their
-// standard errors count that.
+// standard errors count that. The configured cells read a smooth cap across them (a bag's end,
+// LargestBound's `caps`); the half rows only catch what stands out of a row, and the largest of
+// two noisy readings of one crest would stand above it.
 Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double sigma,
                      double radius, double top, const EnvelopeConfig& config) {
     const Eigen::Vector2d u(std::cos(phi), std::sin(phi));
@@ -127,10 +129,11 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
     KeepGapsOnly(fine.back, coarse.back, config);
     Support out;
     int judged = 0;
-    auto farther = [&](const Layers& layers, double extent, bool forward, bool walls) {
+    auto farther = [&](const Layers& layers, double extent, bool forward, bool walls, bool caps) {
         double se = 0.0;
         const auto& cells = forward ? layers.front.cells : layers.back.cells;
-        const double bound = LargestBound(cells, config, sigma, sigma, extent, &se, &judged, walls);
+        const double bound =
+            LargestBound(cells, config, sigma, sigma, extent, &se, &judged, walls, caps);
         double& best = forward ? out.forward : out.backward;
         if (bound > best) {
             best = bound;
@@ -138,9 +141,9 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
         }
     };
     for (bool forward : {true, false}) {
-        farther(fine, std::max(along, height), forward, true);
-        farther(coarse, 2.0 * std::max(along, height), forward, false);
-        farther(thin, std::max(along, height / 2.0), forward, true);
+        farther(fine, std::max(along, height), forward, true, true);
+        farther(coarse, 2.0 * std::max(along, height), forward, false, false);
+        farther(thin, std::max(along, height / 2.0), forward, true, false);
     }
     return out;
 }
@@ -237,7 +240,7 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double he
     MarkCapTops(&grid, sigma, config);
     MarkRidgesToReadHigh(&grid, config);
     int judged = 0;
-    return LargestBound(grid.cells, config, sigma, height_sigma, cell, se, &judged);
+    return LargestBound(grid.cells, config, sigma, height_sigma, cell, se, &judged, true, true);
 }
 
 Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, double height_sigma,

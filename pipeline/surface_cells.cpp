@@ -3,6 +3,8 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 
+#include "pipeline/cap_reach.h"
+
 namespace boxd::envelope {
 
 double UpperNormalQuantile(double q) {
@@ -15,6 +17,10 @@ double UpperNormalQuantile(double q) {
 }
 
 namespace {
+
+// A cap's crest is read from the facing cells within this many cell extents of the chosen one:
+// five cells across, where a bag's crest falls away by about a millimetre.
+constexpr double kCapRadiusCells = 2.5;
 
 // The cell readings' scatter about their mean, and its eigen-decomposition in closed form
 // (computeDirect): it runs for every judged cell of every direction, and the iterative solver
@@ -81,7 +87,7 @@ double MedianOfLargest(int m) { return UpperNormalQuantile(1.0 - std::pow(0.5, 1
 
 double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
                     double noise_sigma, double wall_noise_sigma, double cell_extent_m, double* se,
-                    int* judged, bool walls) {
+                    int* judged, bool walls, bool caps) {
     // A cell's outer layer is one of three things; its own 3-D scatter says which.
     //  - A surface facing the direction (its normal within 60 degrees of it): the mean is the
     //    surface. Tilted by θ, it spreads over the cell's extent e by e·tan θ (at most the
@@ -112,6 +118,7 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
     // HighEndSe, which wanders from cell to cell as the readings fall).
     struct Reach {
         double value, extra_se, noise_se;
+        bool facing = false;
     };
     auto reach_of = [&](const LayerCell& c) -> Reach {
         double off_plane = 0.0;
@@ -123,7 +130,7 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
                 std::min(cell_extent_m * std::sqrt(1.0 - cos_t * cos_t) / cos_t, layer);
             const double se_spread = spread > noise_sigma ? spread / std::sqrt(12.0) : 0.0;
             return {c.Mean() + c.high_end_above_mean_m + c.cap_above_mean_m,
-                    std::hypot(se_spread, c.cap_above_mean_m), c.StdError()};
+                    std::hypot(se_spread, c.cap_above_mean_m), c.StdError(), true};
         }
         if (!walls || var - wall_var <= 3.0 * SampleVarianceSe(wall_var, c.n)) {
             return {c.Mean(), 0.0, c.StdError()};
@@ -136,7 +143,7 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
                 std::hypot(c.StdError(), high_end_se)};
     };
     // Each judged cell's reach, once: it costs an eigen-decomposition of the cell's scatter.
-    std::vector<Reach> reaches(cells.size(), Reach{-INFINITY, 0.0, 0.0});
+    std::vector<Reach> reaches(cells.size(), Reach{-INFINITY, 0.0, 0.0, false});
     int m = 0;
     double top = -INFINITY, top_se = 0.0;
     for (std::size_t k = 0; k < cells.size(); ++k) {
@@ -159,12 +166,34 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
     for (std::size_t k = 0; k < cells.size(); ++k) contenders += competes(k) ? 1 : 0;
     const double z = MedianOfLargest(contenders);
     double best = -INFINITY;
+    std::size_t chosen = 0;
     for (std::size_t k = 0; k < cells.size(); ++k) {
         if (!competes(k)) continue;
         const double bound = reaches[k].value - z * reaches[k].noise_se;
         if (bound > best) {
             best = bound;
+            chosen = k;
             *se = std::hypot(cells[k].StdError(), reaches[k].extra_se);
+        }
+    }
+    // A smooth cap's crest: its cells fall away from it, and a quadratic fitted over the facing
+    // cells round the chosen one reads it (cap_reach.h) where the correction above would take
+    // them for equals.
+    if (caps && reaches[chosen].facing && contenders > 1) {
+        const Eigen::Vector2d at = cells[chosen].sum3.head<2>() / cells[chosen].n;
+        std::vector<std::size_t> near{chosen};
+        std::vector<double> cell_se(cells.size(), 0.0);
+        for (std::size_t k = 0; k < cells.size(); ++k) {
+            if (cells[k].n < config.min_cell_points || !reaches[k].facing) continue;
+            cell_se[k] = cells[k].StdError();
+            const Eigen::Vector2d p = cells[k].sum3.head<2>() / cells[k].n;
+            if (k != chosen && (p - at).norm() <= kCapRadiusCells * cell_extent_m) {
+                near.push_back(k);
+            }
+        }
+        if (const auto cap = FitCapReach(cells, cell_se, near)) {
+            best = cap->value;
+            *se = std::max(*se, cap->se);
         }
     }
     return best;
