@@ -29,7 +29,7 @@ std::optional<CapReach> FitCapReach(const std::vector<LayerCell>& cells,
                                     const std::vector<std::size_t>& near) {
     if (near.size() < kMinCells) return std::nullopt;
     // Coordinates relative to the first cell's centroid keep the normal equations well scaled.
-    const Eigen::Vector3d origin = cells[near.front()].sum3 / cells[near.front()].n;
+    const Eigen::Vector3d origin = cells[near.front()].Centroid();
     Eigen::Matrix<double, kTerms, kTerms> normal = Eigen::Matrix<double, kTerms, kTerms>::Zero();
     Row rhs = Row::Zero();
     std::vector<Row> rows;
@@ -37,8 +37,8 @@ std::optional<CapReach> FitCapReach(const std::vector<LayerCell>& cells,
     double a_lo = INFINITY, a_hi = -INFINITY, b_lo = INFINITY, b_hi = -INFINITY;
     for (std::size_t k : near) {
         const LayerCell& c = cells[k];
-        const Eigen::Vector3d mean = c.sum3 / c.n;
-        const Eigen::Matrix3d cov = c.sum_outer / c.n - mean * mean.transpose();
+        const Eigen::Vector3d mean = c.Centroid();
+        const Eigen::Matrix3d cov = c.Scatter();
         const double a = mean.x() - origin.x(), b = mean.y() - origin.y();
         // The mean of a quadratic over the readings: its value at their centroid plus their
         // spread's share of the squared terms.
@@ -65,8 +65,7 @@ std::optional<CapReach> FitCapReach(const std::vector<LayerCell>& cells,
     // The cells about the surface: within their noise, or the surface is not a quadratic cap.
     double chi2 = 0.0;
     for (std::size_t i = 0; i < near.size(); ++i) {
-        const LayerCell& cell = cells[near[i]];
-        const double residual = cell.sum3.z() / cell.n - origin.z() - rows[i].dot(c);
+        const double residual = cells[near[i]].Centroid().z() - origin.z() - rows[i].dot(c);
         chi2 += residual * residual / (se[near[i]] * se[near[i]]);
     }
     const double dof = static_cast<double>(near.size()) - kTerms;

@@ -27,9 +27,8 @@ constexpr double kCapRadiusCells = 2.5;
 // took a quarter of an irregular object's fit. Its precision suffers where eigenvalues nearly
 // coincide, which a cell's least one (the noise across a surface) and its two larger ones
 // (the cell's extent along it) do not: every case of the accuracy suite reads the same.
-Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> Scatter(const LayerCell& c, Eigen::Matrix3d* cov) {
-    const Eigen::Vector3d mean = c.sum3 / c.n;
-    *cov = c.sum_outer / c.n - mean * mean.transpose();
+Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> Decompose(const LayerCell& c, Eigen::Matrix3d* cov) {
+    *cov = c.Scatter();
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
     eig.computeDirect(*cov);
     return eig;
@@ -39,14 +38,14 @@ Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> Scatter(const LayerCell& c, Eigen
 
 double LayerCell::Facing(double* off_plane) const {
     Eigen::Matrix3d cov;
-    const auto eig = Scatter(*this, &cov);
+    const auto eig = Decompose(*this, &cov);
     if (off_plane != nullptr) *off_plane = std::max(0.0, eig.eigenvalues()(0)) * n / (n - 1);
     return std::abs(eig.eigenvectors().col(0).z());
 }
 
 LayerCell::Slope LayerCell::BestSlope(double noise_sigma) const {
     Eigen::Matrix3d cov;
-    const auto eig = Scatter(*this, &cov);
+    const auto eig = Decompose(*this, &cov);
     const Eigen::Vector3d normal = eig.eigenvectors().col(0);
     Slope out;
     if (std::abs(normal.z()) < 1e-6) return out;
@@ -60,8 +59,7 @@ LayerCell::Slope LayerCell::BestSlope(double noise_sigma) const {
 }
 
 double LayerCell::NarrowerExtentVariance() const {
-    const Eigen::Vector2d mean = sum3.head<2>() / n;
-    const Eigen::Matrix2d cov = sum_outer.topLeftCorner<2, 2>() / n - mean * mean.transpose();
+    const Eigen::Matrix2d cov = Scatter().topLeftCorner<2, 2>();
     const double half_trace = 0.5 * cov.trace();
     const double det = cov.determinant();
     return half_trace - std::sqrt(std::max(0.0, half_trace * half_trace - det));
@@ -180,13 +178,13 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
     // cells round the chosen one reads it (cap_reach.h) where the correction above would take
     // them for equals.
     if (caps && reaches[chosen].facing && contenders > 1) {
-        const Eigen::Vector2d at = cells[chosen].sum3.head<2>() / cells[chosen].n;
+        const Eigen::Vector2d at = cells[chosen].Centroid().head<2>();
         std::vector<std::size_t> near{chosen};
         std::vector<double> cell_se(cells.size(), 0.0);
         for (std::size_t k = 0; k < cells.size(); ++k) {
             if (cells[k].n < config.min_cell_points || !reaches[k].facing) continue;
             cell_se[k] = cells[k].StdError();
-            const Eigen::Vector2d p = cells[k].sum3.head<2>() / cells[k].n;
+            const Eigen::Vector2d p = cells[k].Centroid().head<2>();
             if (k != chosen && (p - at).norm() <= kCapRadiusCells * cell_extent_m) {
                 near.push_back(k);
             }

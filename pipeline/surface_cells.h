@@ -46,6 +46,12 @@ struct LayerCell : CellStats {
         sum3 += p;
         sum_outer += p * p.transpose();
     }
+    // The readings' centroid and their scatter about it (over n), in (across, up, along).
+    Eigen::Vector3d Centroid() const { return sum3 / n; }
+    Eigen::Matrix3d Scatter() const {
+        const Eigen::Vector3d mean = Centroid();
+        return sum_outer / n - mean * mean.transpose();
+    }
     // Returns |cos| of the angle between the surface's normal and the direction judged, and
     // in `off_plane` (when given) the variance of the readings about their best plane: the
     // noise for one surface, more for two (a corner's faces sharing the cell).
