@@ -14,6 +14,7 @@
 #include "pipeline/registration_uncertainty.h"
 #include "pipeline/student_t.h"
 #include "pipeline/table_plane.h"
+#include "pipeline/top_rounding.h"
 #include "pipeline/view_stream.h"
 
 namespace boxd {
@@ -78,9 +79,8 @@ double Confidence(const RegisteredViews& registered, int poses, double face_sigm
 }
 
 // Stages 4b to 7 on the views and edges of `stream`.
-MeasureOutput MeasureViews(const Session& session, ViewStream& stream,
-                           const MeasureConfig& config, BoxMethod method,
-                           const MonotonicMs& clock) {
+MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const MeasureConfig& config,
+                           BoxMethod method, const MonotonicMs& clock) {
     const int n = static_cast<int>(session.poses.size());
     const RefusalConfig& refuse = config.refusal;
     Measurement m(clock);
@@ -130,14 +130,26 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream,
         if (std::isfinite(cuboid->flatness)) quality.face_flatness = cuboid->flatness;
         // The faces' own scatter, and what the registration may still have moved them by; the
         // height is read from the table's plane, which is known as well as its poses agree.
-        const auto moved = RegistrationSigma(fit.fused, *cuboid, registered->poses,
-                                             registered->pose_covariance);
+        const auto moved =
+            RegistrationSigma(fit.fused, *cuboid, registered->poses, registered->pose_covariance);
         spdlog::debug(
             "uncertainty: faces {:.3f} {:.3f} {:.3f} mm, registration {:.3f} {:.3f} mm, table "
             "{:.3f} mm",
             cuboid->sigma_m[0] * 1e3, cuboid->sigma_m[1] * 1e3, cuboid->sigma_m[2] * 1e3,
             moved[0] * 1e3, moved[1] * 1e3, table.center_se_m * 1e3);
-        const double shared[3] = {moved[0], moved[1], table.center_se_m};  // by every face alike
+        // The rounding of the recorded depths, which every view of the top and every pose of
+        // the table meet alike (depth_rounding.h): the two surfaces lie at other depths, so
+        // their roundings are independent.
+        const double unit = session.camera.depth_unit_m;
+        const double rounding =
+            std::hypot(SharedRoundingSigma(
+                           TopRounding(fit.fused, registered->poses, *cuboid, table.camera_to_table,
+                                       session.calibration, config.box_fit.min_band_m,
+                                       config.envelope.edge_margin_m),
+                           unit),
+                       SharedRoundingSigma(table.rounding, unit));
+        spdlog::debug("uncertainty: the depths' rounding {:.3f} mm in the height", rounding * 1e3);
+        const double shared[3] = {moved[0], moved[1], std::hypot(table.center_se_m, rounding)};
         for (std::size_t i = 0; i < 3; ++i) {
             // kNormal95 sigmas: the 95% bound of SPEC section 5's uncertainty_m.
             uncertainty[i] = kNormal95 * std::hypot(cuboid->sigma_m[i], shared[i]);

@@ -99,6 +99,40 @@ double CenterStandardError(const std::vector<std::vector<Eigen::Vector3d>>& pose
     return HeightAtOrigin(pts, plane, band, &variance) ? std::sqrt(std::max(variance, 0.0)) : 0.0;
 }
 
+// The table's readings within `band` of `plane` as the rounding of their depths sees them
+// (depth_rounding.h), at most kRoundingReadings of them. `recorded` maps the camera into the
+// frame of the readings.
+RoundingEvidence TableRounding(const std::vector<std::vector<Eigen::Vector3d>>& poses,
+                               const Plane& plane, double band, const Eigen::Isometry3d& recorded,
+                               const StationCalibration& calibration) {
+    const Eigen::Vector3d camera = recorded.translation();
+    const Eigen::Vector3d axis = recorded.linear().col(2);
+    const double camera_side = plane.normal.dot(camera) + plane.d;
+    RoundingEvidence out;
+    double squares = 0.0;
+    for (const auto& pose : poses) {
+        for (const Eigen::Vector3d& p : pose) {
+            const double r = plane.normal.dot(p) + plane.d;
+            const Eigen::Vector3d ray = p - camera;
+            const double depth = ray.dot(axis), across = plane.normal.dot(ray);
+            if (std::abs(r) > band || !(depth > 0.0) || across == 0.0) continue;
+            // A depth error e moves the reading along its ray by e / (r . a), across the plane
+            // by that times |n . r|; the plane meets the ray at depth t (r . a).
+            const double gain = std::abs(across) / depth;
+            const double fitted = -camera_side / across * depth;
+            out.raw_depths_m.push_back((fitted - calibration.depth_offset_m) /
+                                       calibration.depth_scale);
+            out.gains.push_back(gain);
+            squares += (r / gain) * (r / gain);
+        }
+    }
+    if (!out.gains.empty()) {
+        out.depth_scatter_m = std::sqrt(squares / static_cast<double>(out.gains.size()));
+    }
+    out.Thin(kRoundingReadings);
+    return out;
+}
+
 }  // namespace
 
 Status TablePlaneConfig::Validate() const {
@@ -191,6 +225,7 @@ Result<TablePlaneFit> FitTableCandidates(const std::vector<std::vector<Eigen::Ve
     fit.tilt_correction_deg = std::acos(std::clamp(plane.normal.z(), -1.0, 1.0)) * 180.0 / M_PI;
     fit.height_correction_m = plane.d;  // signed distance of the recorded origin to the plane
     fit.center_se_m = CenterStandardError(poses, plane, config.trim_sigmas * sigma);
+    fit.rounding = TableRounding(poses, plane, config.trim_sigmas * sigma, recorded, calibration);
     if (fit.tilt_correction_deg > config.max_tilt_deg ||
         std::abs(fit.height_correction_m) > config.max_shift_m) {
         return Error{ErrorCode::kRegistrationFailed,

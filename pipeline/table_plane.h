@@ -9,6 +9,7 @@
 
 #include "pipeline/camera.h"
 #include "pipeline/depth_image.h"
+#include "pipeline/depth_rounding.h"
 #include "pipeline/point_cloud.h"
 #include "pipeline/result.h"
 #include "pipeline/station_calibration.h"
@@ -39,6 +40,9 @@ struct TablePlaneFit {
     // the root of their count. With one pose, the least-squares error of its readings.
     double center_se_m = 0.0;
     int points = 0;
+    // The table's readings as the rounding of their recorded depths sees them: what it leaves
+    // in the plane's height is shared by every pose (depth_rounding.h).
+    RoundingEvidence rounding;
 };
 
 // Returns the back-projected, depth-corrected camera-frame point of every `stride`-th valid pixel

@@ -81,6 +81,41 @@ TEST(CliMeasure, MeasuresABoxAndWritesTheCloud) {
     EXPECT_EQ(pca["obb"], j["obb"]);
 }
 
+// A sensor without noise rounds a top and the table alike in every view (depth_rounding.h): the
+// views agree to the micrometre, and the height's bound must carry the rounding instead. Two
+// stations nobody chose (the ideal-box sweep's seed 1, cases 0 and 3), recorded in 1 mm and in
+// 0.1 mm units.
+TEST(CliMeasure, ANoiseFreeHeightsBoundCarriesTheDepthsRounding) {
+    TempDir dir;
+    const std::vector<std::vector<std::string>> stations{
+        {"--dims", "0.184", "0.172", "0.396", "--seed", "1000", "--distance", "1.08", "--elevation",
+         "32", "--aim-height", "0.122", "--offset", "-0.024", "0", "--yaw", "30"},
+        {"--dims", "0.168", "0.143", "0.378", "--seed", "1003", "--distance", "0.91", "--elevation",
+         "42", "--aim-height", "0.214", "--offset", "-0.020", "0.024", "--yaw", "31"}};
+    for (std::size_t k = 0; k < stations.size(); ++k) {
+        for (const std::string unit : {"0.001", "0.0001"}) {
+            std::vector<std::string> args = stations[k];
+            args.insert(args.end(), {"--noise", "none", "--depth-unit-m", unit});
+            std::string name = "station";
+            name += std::to_string(k);
+            name += unit;
+            const json j = Measure(Synth(dir, name, args), 0);
+            ASSERT_EQ(j["status"], "ok") << k << " " << unit;
+            const double truth = std::stod(stations[k][3]);
+            const double error = j["dimensions"]["height_m"].get<double>() - truth;
+            const double bound = j["uncertainty_m"]["height_m"].get<double>();
+            EXPECT_LE(std::abs(error), bound + 1e-9) << k << " " << unit;
+            // In 1 mm units the rounding is most of the bound (the views' own part is 0.01 mm);
+            // in 0.1 mm units a tenth of that is left.
+            if (unit == "0.001") {
+                EXPECT_GE(bound, 0.00004) << k;
+            } else {
+                EXPECT_LE(bound, 0.00002) << k;
+            }
+        }
+    }
+}
+
 TEST(CliMeasure, ATubeIsIrregularAndTwoParcelsAreRefused) {
     TempDir dir;
     const auto tube = Synth(
@@ -131,16 +166,17 @@ TEST(CliMeasure, CalibrationFileReplacesTheSessionsCalibration) {
     TempDir dir;
     // The station's lens is 1% longer than recorded: the box reads ~1% large with the session's
     // calibration, right with a file that knows the lens.
-    const auto session = Synth(dir, "s", {"--dims", "0.4", "0.3", "0.25", "--focal-error-pct", "1",
-                                          "--calib-center-error-m", "0", "--calib-axis-error-deg",
-                                          "0"});
+    const auto session = Synth(dir, "s",
+                               {"--dims", "0.4", "0.3", "0.25", "--focal-error-pct", "1",
+                                "--calib-center-error-m", "0", "--calib-axis-error-deg", "0"});
     const json recorded = json::parse(std::ifstream(session / "session.json"))["calibration"];
     json lens = recorded;
     lens["focal_scale"] = 1.01;
     const auto file = WriteFile(dir, "lens.yaml", "calibration: " + lens.dump() + "\n");
     const double before = Measure(session, 0)["dimensions"]["length_m"].get<double>();
     const double after =
-        Measure(session, 0, {"--calibration", file.string()})["dimensions"]["length_m"].get<double>();
+        Measure(session, 0, {"--calibration", file.string()})["dimensions"]["length_m"]
+            .get<double>();
     EXPECT_GT(before - 0.4, 0.002);
     EXPECT_NEAR(after, 0.4, 0.001);
 }
@@ -149,8 +185,8 @@ TEST(CliMeasure, BadCalibrationFileIsBadInputNamingTheField) {
     TempDir dir;
     const auto session = Synth(dir, "s", {"--dims", "0.3", "0.2", "0.2"});
     auto expect_bad = [&](const std::filesystem::path& file, const std::string& names) {
-        const auto r = RunBoxd({"measure", "--session", session.string(), "--calibration",
-                                file.string()});
+        const auto r =
+            RunBoxd({"measure", "--session", session.string(), "--calibration", file.string()});
         EXPECT_EQ(r.exit_code, 2) << r.out;
         EXPECT_TRUE(r.out.empty());
         EXPECT_NE(r.err.find(names), std::string::npos) << r.err;
@@ -204,7 +240,8 @@ TEST(CliMeasure, OversizedFramesAndTooManyFramesAreBadInputNotACrash) {
     expect_bad("poses[0].frames: must be an array of 1 to 64 paths");
     // A frame larger than the camera: its header is enough to refuse it.
     std::ofstream(session / "session.json") << meta.dump();
-    ASSERT_TRUE(cv::imwrite((session / first).string(), cv::Mat(2000, 3000, CV_16UC1, cv::Scalar(900))));
+    ASSERT_TRUE(
+        cv::imwrite((session / first).string(), cv::Mat(2000, 3000, CV_16UC1, cv::Scalar(900))));
     expect_bad("image is 3000x2000, expected 640x480");
 }
 

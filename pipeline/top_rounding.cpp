@@ -1,0 +1,49 @@
+#include "pipeline/top_rounding.h"
+
+#include <cmath>
+
+namespace boxd {
+
+RoundingEvidence TopRounding(const FusedCloud& cloud, const std::vector<Se2>& poses,
+                             const EnclosingCuboid& cuboid,
+                             const Eigen::Isometry3d& camera_to_table,
+                             const StationCalibration& calibration, double band, double margin) {
+    const Eigen::Isometry3d table_to_camera = camera_to_table.inverse();
+    // The top's normal in the camera's frame, the same in every view (the table turns about
+    // it), and the camera's height under the top.
+    const Eigen::Vector3d up = table_to_camera.linear().col(2);
+    const double below = cuboid.height_m - camera_to_table.translation().z();
+    const Eigen::Vector2d along = cuboid.length_axis.normalized();
+    const Eigen::Vector2d across(-along.y(), along.x());
+    const double half_l = 0.5 * cuboid.length_m - margin, half_w = 0.5 * cuboid.width_m - margin;
+    std::vector<Se2> into_view(poses.size());
+    for (std::size_t k = 0; k < poses.size(); ++k) into_view[k] = poses[k].Inverse();
+    RoundingEvidence out;
+    double squares = 0.0;
+    for (std::size_t i = 0; i < cloud.unfiltered.size(); ++i) {
+        const Eigen::Vector3f& p = cloud.unfiltered[i];
+        const double r = p.z() - cuboid.height_m;
+        if (std::abs(r) > band) continue;
+        const Eigen::Vector2d xy = p.head<2>().cast<double>() - cuboid.center_m;
+        if (std::abs(xy.dot(along)) > half_l || std::abs(xy.dot(across)) > half_w) continue;
+        const std::size_t k = cloud.unfiltered_view[i];
+        if (k >= poses.size()) continue;
+        const Eigen::Vector3d ray = table_to_camera * into_view[k].Apply(p).cast<double>();
+        const double rise = up.dot(ray);
+        if (!(ray.z() > 0.0) || rise == 0.0) continue;
+        // A depth error e moves the reading along its ray by e / (r . a), up by that times
+        // |n . r|; the top meets the ray at depth (below / n . r) (r . a).
+        const double gain = std::abs(rise) / ray.z();
+        const double fitted = below / rise * ray.z();
+        out.raw_depths_m.push_back((fitted - calibration.depth_offset_m) / calibration.depth_scale);
+        out.gains.push_back(gain);
+        squares += (r / gain) * (r / gain);
+    }
+    if (!out.gains.empty()) {
+        out.depth_scatter_m = std::sqrt(squares / static_cast<double>(out.gains.size()));
+    }
+    out.Thin(kRoundingReadings);
+    return out;
+}
+
+}  // namespace boxd

@@ -1,0 +1,26 @@
+#pragma once
+// The top's readings as the rounding of their recorded depths sees them (depth_rounding.h): a
+// horizontal top meets the same rounding in every view, so what it leaves in the height is
+// shared by the views and their agreement cannot show it.
+
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "pipeline/depth_rounding.h"
+#include "pipeline/enclosing_cuboid.h"
+#include "pipeline/fusion.h"
+#include "pipeline/se2.h"
+#include "pipeline/station_calibration.h"
+
+namespace boxd {
+
+// Returns the evidence of the readings of `cloud` (fused by `poses`) within `band` of the top
+// of `cuboid` and `margin` inside its footprint: the raw depths of the view that holds the most
+// of them, and all of them for their scatter along the depth and the gain. `camera_to_table`
+// maps the camera into every view's own frame; `calibration` gives the depths' correction.
+RoundingEvidence TopRounding(const FusedCloud& cloud, const std::vector<Se2>& poses,
+                             const EnclosingCuboid& cuboid,
+                             const Eigen::Isometry3d& camera_to_table,
+                             const StationCalibration& calibration, double band, double margin);
+
+}  // namespace boxd
