@@ -5,6 +5,17 @@
 
 namespace boxd {
 
+void RoundingEvidence::Add(double raw_fitted_depth_m, double gain, double residual_m) {
+    raw_depths_m.push_back(raw_fitted_depth_m);
+    gains.push_back(gain);
+    squares_ += (residual_m / gain) * (residual_m / gain);
+}
+
+void RoundingEvidence::Finish() {
+    if (!gains.empty()) depth_scatter_m = std::sqrt(squares_ / static_cast<double>(gains.size()));
+    Thin(kRoundingReadings);
+}
+
 void RoundingEvidence::Thin(std::size_t max_readings) {
     const std::size_t n = raw_depths_m.size();
     if (n <= max_readings || max_readings == 0) return;

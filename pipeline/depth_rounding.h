@@ -44,8 +44,16 @@ struct RoundingEvidence {
     // The readings' root-mean-square distance from the surface, along their depth.
     double depth_scatter_m = 0.0;
 
+    // Adds a reading: the fitted surface's raw depth along its ray, its gain (> 0) and its
+    // distance from the surface along the surface's normal.
+    void Add(double raw_fitted_depth_m, double gain, double residual_m);
+    // Ends the adding: the readings' scatter, and at most kRoundingReadings of them kept.
+    void Finish();
     // Keeps at most `max_readings` readings, evenly spread (the sum above is estimated from them).
     void Thin(std::size_t max_readings);
+
+private:
+    double squares_ = 0.0;  // of the readings' residuals along their depth
 };
 
 // Returns the 1-sigma by which the rounding to `unit_m` moves the surface of `evidence` along

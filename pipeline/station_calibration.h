@@ -24,6 +24,8 @@ struct StationCalibration {
 
     // Returns the depth after the depth correction.
     double CorrectDepth(double raw_z_m) const { return raw_z_m * depth_scale + depth_offset_m; }
+    // The raw z the camera recorded for the corrected `z_m` (CorrectDepth's inverse).
+    double RawDepth(double z_m) const { return (z_m - depth_offset_m) / depth_scale; }
 
     // Returns `camera` with the focal lengths this calibration uses.
     CameraIntrinsics Lens(const CameraIntrinsics& camera) const {

@@ -100,7 +100,7 @@ double CenterStandardError(const std::vector<std::vector<Eigen::Vector3d>>& pose
 }
 
 // The table's readings within `band` of `plane` as the rounding of their depths sees them
-// (depth_rounding.h), at most kRoundingReadings of them. `recorded` maps the camera into the
+// (depth_rounding.h). `recorded` maps the camera into the
 // frame of the readings.
 RoundingEvidence TableRounding(const std::vector<std::vector<Eigen::Vector3d>>& poses,
                                const Plane& plane, double band, const Eigen::Isometry3d& recorded,
@@ -109,7 +109,6 @@ RoundingEvidence TableRounding(const std::vector<std::vector<Eigen::Vector3d>>& 
     const Eigen::Vector3d axis = recorded.linear().col(2);
     const double camera_side = plane.normal.dot(camera) + plane.d;
     RoundingEvidence out;
-    double squares = 0.0;
     for (const auto& pose : poses) {
         for (const Eigen::Vector3d& p : pose) {
             const double r = plane.normal.dot(p) + plane.d;
@@ -118,18 +117,11 @@ RoundingEvidence TableRounding(const std::vector<std::vector<Eigen::Vector3d>>& 
             if (std::abs(r) > band || !(depth > 0.0) || across == 0.0) continue;
             // A depth error e moves the reading along its ray by e / (r . a), across the plane
             // by that times |n . r|; the plane meets the ray at depth t (r . a).
-            const double gain = std::abs(across) / depth;
-            const double fitted = -camera_side / across * depth;
-            out.raw_depths_m.push_back((fitted - calibration.depth_offset_m) /
-                                       calibration.depth_scale);
-            out.gains.push_back(gain);
-            squares += (r / gain) * (r / gain);
+            out.Add(calibration.RawDepth(-camera_side / across * depth), std::abs(across) / depth,
+                    r);
         }
     }
-    if (!out.gains.empty()) {
-        out.depth_scatter_m = std::sqrt(squares / static_cast<double>(out.gains.size()));
-    }
-    out.Thin(kRoundingReadings);
+    out.Finish();
     return out;
 }
 

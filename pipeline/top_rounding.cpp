@@ -19,7 +19,6 @@ RoundingEvidence TopRounding(const FusedCloud& cloud, const std::vector<Se2>& po
     std::vector<Se2> into_view(poses.size());
     for (std::size_t k = 0; k < poses.size(); ++k) into_view[k] = poses[k].Inverse();
     RoundingEvidence out;
-    double squares = 0.0;
     for (std::size_t i = 0; i < cloud.unfiltered.size(); ++i) {
         const Eigen::Vector3f& p = cloud.unfiltered[i];
         const double r = p.z() - cuboid.height_m;
@@ -33,16 +32,9 @@ RoundingEvidence TopRounding(const FusedCloud& cloud, const std::vector<Se2>& po
         if (!(ray.z() > 0.0) || rise == 0.0) continue;
         // A depth error e moves the reading along its ray by e / (r . a), up by that times
         // |n . r|; the top meets the ray at depth (below / n . r) (r . a).
-        const double gain = std::abs(rise) / ray.z();
-        const double fitted = below / rise * ray.z();
-        out.raw_depths_m.push_back((fitted - calibration.depth_offset_m) / calibration.depth_scale);
-        out.gains.push_back(gain);
-        squares += (r / gain) * (r / gain);
+        out.Add(calibration.RawDepth(below / rise * ray.z()), std::abs(rise) / ray.z(), r);
     }
-    if (!out.gains.empty()) {
-        out.depth_scatter_m = std::sqrt(squares / static_cast<double>(out.gains.size()));
-    }
-    out.Thin(kRoundingReadings);
+    out.Finish();
     return out;
 }
 

@@ -87,6 +87,16 @@ TEST(SharedRoundingSigma, IsNothingWithoutReadingsOrUnit) {
     EXPECT_EQ(SharedRoundingSigma(RowsOfOneDepth(10, 10, 1.0, 0.0013, 0.0), 0.0), 0.0);
 }
 
+TEST(RoundingEvidence, AddReadsTheScatterAlongTheDepthAndFinishThins) {
+    RoundingEvidence e;
+    // Readings 0.3 mm off the surface along its normal, at a gain of a half: 0.6 mm in depth.
+    for (int i = 0; i < 30000; ++i) e.Add(1.0 + 1e-5 * i, 0.5, i % 2 == 0 ? 0.0003 : -0.0003);
+    e.Finish();
+    EXPECT_NEAR(e.depth_scatter_m, 0.0006, 1e-12);
+    EXPECT_EQ(e.raw_depths_m.size(), kRoundingReadings);
+    EXPECT_EQ(e.gains.size(), kRoundingReadings);
+}
+
 TEST(RoundingEvidence, ThinKeepsAnEvenSpread) {
     RoundingEvidence e = RowsOfOneDepth(100, 100, 1.0, 0.002003, 0.0);
     const double before = SharedRoundingSigma(e, kUnit);
