@@ -12,8 +12,8 @@
 // by g_i per metre of depth error, is off by the mean of g_i e(z_i). Where the surface lies
 // within its unit is unknown (a common shift of every z_i), and over that shift the mean has
 // the variance
-//     sum_k u^2 / (2 pi^2 k^2) exp(-4 pi^2 k^2 sigma^2 / u^2) |(1/N) sum_i g_i exp(2 pi i k z_i /
-//     u)|^2:
+//     sum_k u^2 / (2 pi^2 k^2) exp(-4 pi^2 k^2 sigma^2 / u^2) |S_k|^2,
+//     S_k = (1/N) sum_i g_i exp(2 pi i k z_i / u):
 // for readings at random depths about g^2 u^2 / (12 N), but readings that share depths (a
 // horizontal surface has one depth along an image row) or fall at a few phases of the unit (a
 // sampling stride that nearly repeats the unit) keep it large. The z_i are the fitted surface's

@@ -100,8 +100,7 @@ double CenterStandardError(const std::vector<std::vector<Eigen::Vector3d>>& pose
 }
 
 // The table's readings within `band` of `plane` as the rounding of their depths sees them
-// (depth_rounding.h). `recorded` maps the camera into the
-// frame of the readings.
+// (depth_rounding.h). `recorded` maps the camera into the frame of the readings.
 RoundingEvidence TableRounding(const std::vector<std::vector<Eigen::Vector3d>>& poses,
                                const Plane& plane, double band, const Eigen::Isometry3d& recorded,
                                const StationCalibration& calibration) {
