@@ -15,9 +15,10 @@
 namespace boxd {
 
 // Returns the evidence of the readings of `cloud` (fused by `poses`) within `band` of the top
-// of `cuboid` and `margin` inside its footprint: the raw depths of the view that holds the most
-// of them, and all of them for their scatter along the depth and the gain. `camera_to_table`
-// maps the camera into every view's own frame; `calibration` gives the depths' correction.
+// of `cuboid` and `margin` inside its footprint, every view's: the fitted top's raw depth along
+// each reading's ray, its gain, and the readings' scatter along their depth (at most
+// kRoundingReadings kept). `camera_to_table` maps the camera into every view's own frame;
+// `calibration` gives the depths' correction.
 RoundingEvidence TopRounding(const FusedCloud& cloud, const std::vector<Se2>& poses,
                              const EnclosingCuboid& cuboid,
                              const Eigen::Isometry3d& camera_to_table,
