@@ -60,8 +60,16 @@ double FillRatio(const envelope::Surface& surface, const EnclosingCuboid& c,
     return std::min(1.0, CellHullArea(footprint, cell, config.fill_cell_points) / reference);
 }
 
-// The share of the footprint cells (fill_cell_m, holding at least fill_cell_points readings) whose
-// highest reading lies within the top band below `height`.
+// The share of the footprint's readings (in cells of fill_cell_m holding at least
+// fill_cell_points) that stand in a cell whose highest reading lies within the top band below
+// the height. Each cell counts by its readings, not as one: a cell beside a wall that holds only
+// the few readings the noise scatters off it has its highest anywhere up the wall, and tells
+// nothing about the top, while a surface below the top band (a lying tube's flank, the carton
+// under an open flap, a bag's sides) fills its cells with readings. Counted alike, the scattered
+// cells round a 0.1 x 0.1 x 0.6 m box whose top was seen at 80 degrees (its inside empty)
+// made a sixth of its cells and read it irregular (0.84); by readings it reads 1.00, the
+// suite's boxes and parcels 0.99-1.00, its lying tubes 0.58-0.64, bags 0.43-0.73, open flaps
+// 0.12-0.36.
 double TopCover(const envelope::Surface& surface, double height, const EnvelopeConfig& config) {
     const double cell = config.fill_cell_m;
     std::map<std::pair<int, int>, std::pair<int, float>> cells;  // readings, highest z
@@ -72,13 +80,13 @@ double TopCover(const envelope::Surface& surface, double height, const EnvelopeC
         c.second = std::max(c.second, p.z());
     }
     const double floor = height - std::max(config.top_band * height, 0.01);
-    int occupied = 0, top = 0;
+    long readings = 0, top = 0;
     for (const auto& [key, c] : cells) {
         if (c.first < config.fill_cell_points) continue;
-        ++occupied;
-        top += c.second >= floor ? 1 : 0;
+        readings += c.first;
+        top += c.second >= floor ? c.first : 0;
     }
-    return occupied > 0 ? static_cast<double>(top) / occupied : 0.0;
+    return readings > 0 ? static_cast<double>(top) / static_cast<double>(readings) : 0.0;
 }
 
 }  // namespace

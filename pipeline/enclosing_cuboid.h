@@ -62,10 +62,11 @@ struct EnvelopeConfig {
     double fill_cell_m = 0.01;  // footprint cells of the fill's hull ...
     int fill_cell_points = 3;   // ... holding at least this many readings
     double max_relative_excess = 0.03;
-    // ... and its top is flat over the whole footprint: of the footprint cells that hold readings,
-    // at least min_top_cover reach within top_band of the height up (a box's rounded edge drops
-    // by its radius; an open flap, a lying tube's curve or a bag's top leave most cells far
-    // below their highest point). The band is a share of the height, at least a centimetre.
+    // ... and its top is flat over the whole footprint: of the readings of the footprint cells,
+    // at least min_top_cover stand in cells that reach within top_band of the height up (a box's
+    // rounded edge drops by its radius; an open flap, a lying tube's curve or a bag's top leave
+    // most cells far below their highest point). The band is a share of the height, at least a
+    // centimetre.
     double top_band = 0.1;
     double min_top_cover = 0.9;
     // ... and each face stands where all views see it: their offsets spread by no more than

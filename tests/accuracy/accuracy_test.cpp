@@ -35,6 +35,7 @@ struct Outcome {
     std::string expect;          // the refusal code a refusal case must give
     std::string expect_message;  // ... and words its message must hold, if any
     std::string shape;
+    std::string expect_shape;  // the shape its group must read (ExpectedShape)
     std::string status;
     std::string reason;
     std::string message;  // the refusal's message
@@ -43,6 +44,14 @@ struct Outcome {
     double uncertainty[3] = {NAN, NAN, NAN};  // the reported 95% bounds, metres
     double processing_ms = 0.0;
 };
+
+// The shape (SPEC section 5) a group's objects must read: boxes and parcels with flat faces at
+// right angles (bulging, strapped, labelled, rounded) are cuboids, seen from any number of poses;
+// tubes, bags, L-shapes and open flaps are irregular. Refusals read none.
+std::string ExpectedShape(const std::string& group) {
+    if (group == "tube" || group == "irregular" || group == "open flap") return "irregular";
+    return group == "refusal" ? "" : "cuboid";
+}
 
 std::vector<std::string> SynthArgs(const json& c, const std::string& out) {
     auto num = [](double v) {
@@ -82,6 +91,7 @@ Outcome RunCase(const json& c) {
     o.name = c["name"].get<std::string>();
     o.tol = c.value("tol_m", 0.0);
     o.group = c.value("group", "box");
+    o.expect_shape = ExpectedShape(o.group);
     o.expect = c.value("expect", "");
     o.expect_message = c.value("expect_message", "");
     test::TempDir dir;
@@ -252,6 +262,7 @@ TEST(Accuracy, SyntheticSuiteWithinTolerance) {
             continue;
         }
         EXPECT_EQ(o.status, "ok") << o.name << ": " << o.reason;
+        EXPECT_EQ(o.shape, o.expect_shape) << o.name;
         for (int k = 0; k < 3; ++k) {
             EXPECT_LE(std::abs(o.err[k]), o.tol) << o.name << " dimension " << k;
         }

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <random>
 #include <string>
 #include <utility>
 #include <vector>
@@ -209,6 +210,54 @@ TEST(FitEnclosingCuboid, StepFillingItsFootprintIsIrregularByItsTop) {
     EXPECT_NEAR(c.height_m, 2.0 * h, 0.003);
 }
 
+TEST(FitEnclosingCuboid, TallNarrowBoxWithItsTopSeenAtGrazingIsACuboid) {
+    // A 0.1 x 0.1 x 0.6 m box whose top a camera barely above it sees only in its middle, and
+    // readings scattered 3-20 mm in from its walls at any height (the noise of a tall wall seen
+    // at grazing). The cells beside the walls then hold a handful of readings whose highest lies
+    // anywhere up the wall: counted as cells, they read the top as covering 0.84 of the
+    // footprint and the box as irregular; counted by their readings, 0.99.
+    const double half = 0.05, h = 0.6;
+    CloudBuilder builder(0.3, {0.01, -0.02}, kSigma, 11);
+    for (double side : {-1.0, 1.0}) {
+        builder.Patch(-half, half, 0.0, h, [&](double a, double z, auto& p, auto& n) {
+            p = {side * half, a, z};
+            n = {side, 0.0, 0.0};
+            return true;
+        });
+        builder.Patch(-half, half, 0.0, h, [&](double a, double z, auto& p, auto& n) {
+            p = {a, side * half, z};
+            n = {0.0, side, 0.0};
+            return true;
+        });
+    }
+    builder.Patch(-0.02, 0.02, -0.02, 0.02, [&](double a, double b, auto& p, auto& n) {
+        p = {a, b, h};
+        n = {0.0, 0.0, 1.0};
+        return true;
+    });
+    FusedCloud cloud = builder.cloud();
+    std::mt19937 rng(12);
+    std::uniform_real_distribution<double> along(-half, half), height(0.02, h), inside(0.003, 0.02);
+    const double c = std::cos(0.3), s = std::sin(0.3);
+    for (int i = 0; i < 300; ++i) {
+        const double depth = half - inside(rng), a = along(rng);
+        const Eigen::Vector2d q = (i % 2 == 0) ? Eigen::Vector2d((i % 4 == 0 ? 1 : -1) * depth, a)
+                                               : Eigen::Vector2d(a, (i % 4 == 1 ? 1 : -1) * depth);
+        cloud.points.emplace_back(static_cast<float>(0.01 + c * q.x() - s * q.y()),
+                                  static_cast<float>(-0.02 + s * q.x() + c * q.y()),
+                                  static_cast<float>(height(rng)));
+        cloud.view.push_back(static_cast<std::uint16_t>(i % kViews));
+    }
+    const Fitted f = Fit(cloud);
+    ASSERT_TRUE(f.box.ok()) << f.box.error().message;
+    ASSERT_TRUE(f.cuboid.ok()) << f.cuboid.error().message;
+    EXPECT_GT(f.cuboid->top_cover, 0.95);
+    EXPECT_TRUE(f.cuboid->cuboid) << "fill " << f.cuboid->fill << ", top cover "
+                                  << f.cuboid->top_cover;
+    EXPECT_NEAR(f.cuboid->length_m, 2.0 * half, kFaceTol);
+    EXPECT_NEAR(f.cuboid->width_m, 2.0 * half, kFaceTol);
+}
+
 TEST(FitEnclosingCuboid, PanelOpenedAtThirtyDegreesIsReadAtItsHighEnd) {
     // A 0.4 x 0.3 x 0.2 carton whose top panel (half the length) is opened 30 degrees about the
     // +x top edge: its outer face rises to the panel's free end, 0.1 m above the top. The top's
@@ -302,7 +351,7 @@ TEST(FitEnclosingCuboid, ThinCloudIsInsufficientDataWithoutABox) {
 
     // Nothing above the table at all, and an empty cloud.
     FusedCloud flat;
-    for (int i = 0; i < 200; ++i) {
+    for (int i = 0; i < 300; ++i) {
         flat.points.emplace_back(0.001f * i, 0.0f, 0.005f);
         flat.view.push_back(0);
     }
