@@ -1,6 +1,7 @@
 #include "pipeline/icp.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <vector>
 
@@ -32,6 +33,9 @@ Status IcpConfig::Validate(const std::string& where) const {
     }
     if (!(robust_scale_m > 0.0)) return bad("robust_scale_m", "must be > 0");
     if (!(point_to_point_weight >= 0.0)) return bad("point_to_point_weight", "must be >= 0");
+    if (!(degenerate_share >= 0.0 && degenerate_share < 1.0)) {
+        return bad("degenerate_share", "must be in [0, 1)");
+    }
     if (!(sigma_floor_m > 0.0)) return bad("sigma_floor_m", "must be > 0");
     if (!(prior_translation_sigma_m > 0.0)) return bad("prior_translation_sigma_m", "must be > 0");
     if (!(prior_yaw_sigma_rad > 0.0)) return bad("prior_yaw_sigma_rad", "must be > 0");
@@ -128,8 +132,14 @@ IcpResult AlignIcp(const OrientedPoints& source, const IcpTarget& target, const 
         Eigen::Matrix3d h = lin.jtj + lin.p2p_jtj;
         h.diagonal() += prior_w;
         const Eigen::Vector3d g = lin.jtr + lin.p2p_jtr + prior_w.cwiseProduct(from_init);
-        const Eigen::Vector3d delta = h.ldlt().solve(-g);
+        Eigen::Vector3d delta = h.ldlt().solve(-g);
         if (!delta.allFinite()) break;
+        // No step along a degenerate direction (IcpConfig::degenerate_share).
+        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> planes(lin.jtj.topLeftCorner<2, 2>());
+        if (planes.eigenvalues()(0) < config.degenerate_share * planes.eigenvalues()(1)) {
+            const Eigen::Vector2d free = planes.eigenvectors().col(0);
+            delta.head<2>() -= free * free.dot(delta.head<2>());
+        }
         t = Se2{delta.x(), delta.y(), delta.z()}.Compose(t);
         if (delta.head<2>().norm() < config.translation_tolerance_m &&
             std::abs(delta.z()) < config.yaw_tolerance_rad) {

@@ -25,9 +25,24 @@ struct IcpConfig {
     // registration_cloud.h); Geman-McClure weights with this scale damp the remaining outliers.
     double min_normal_dot = 0.9;
     double robust_scale_m = 0.004;
-    // Weight of an in-plane point-to-point term beside point-to-plane. Where the data leave a
-    // direction free (one face seen face-on), the outlines of the faces still fix it.
+    // Weight of an in-plane point-to-point term beside point-to-plane: it pulls the outlines of
+    // the faces together, which speeds the coarse alignment from afar.
     double point_to_point_weight = 0.3;
+    // A degenerate direction: an in-plane direction that the surfaces' normals fix with less than
+    // this share of the information of the best-fixed one. Two views that share one face only
+    // (four poses a quarter turn apart) leave the slide along it free but for the face's outline,
+    // and outlines seen at different incidences (a face at 30 degrees in one view, 60 in the
+    // other) end at different places: dropouts at grazing, mixed pixels at the silhouette. The
+    // point-to-point term then slid such alignments 8-12 mm along the face, on a station with
+    // an exact turntable, and the table's centre followed them (a box 3-8 mm small). The
+    // alignment does not move along a degenerate direction (solution remapping, Zhang, Kaess and
+    // Singh 2016): it keeps the turntable model's place there, and the pose graph, to which the
+    // direction's information is next to nothing, fills it from the other alignments. One face
+    // alone fixes its slide with a few thousandths of its normal's information, two faces a
+    // quarter turn apart seen at 30 and 60 degrees with a quarter or more; a curved surface's
+    // alignments (a tube's, a bag's) hold about a tenth, and a share of 0.15 left them free
+    // where they are not (the suite's tubes and bags read up to 1.4 mm off, from 0.7).
+    double degenerate_share = 0.02;
     double sigma_floor_m = 0.0005;  // lower bound of the residual sigma in the information
     // A weak prior toward `init` (the turntable model) keeps directions the data leave free
     // (sliding along a single visible face) where they started instead of letting them drift.

@@ -43,7 +43,8 @@ TEST(AlignIcp, RecoversKnownPlanarMotionCoarseThenFine) {
     // The source is the same scene seen after the inverse motion: truth maps it back.
     const Points source_pts = Move(BoxView(0.0005, 2), truth.Inverse());
     IcpTarget target(BuildRegistrationCloud(target_pts, cloud_cfg, kViewpoint), 0.01);
-    const OrientedPoints source = BuildRegistrationCloud(source_pts, cloud_cfg, truth.Inverse().Apply(kViewpoint));
+    const OrientedPoints source =
+        BuildRegistrationCloud(source_pts, cloud_cfg, truth.Inverse().Apply(kViewpoint));
     IcpConfig coarse;
     coarse.max_correspondence_m = 0.03;
     const IcpResult c = AlignIcp(source, target, Se2{}, coarse);
@@ -98,6 +99,47 @@ TEST(AlignIcp, ReportsNoOverlap) {
     const IcpResult r = AlignIcp(far, target, Se2{}, IcpConfig{});
     EXPECT_FALSE(r.converged);
     EXPECT_EQ(r.fitness, 0.0);
+}
+
+// One face (x = 0.15, facing +x, 0.2 m wide) and the top above it: all that two views share
+// when each sees the face at its own incidence (four poses a quarter turn apart).
+Points SharedFace() {
+    Points pts;
+    const double step = 0.003;
+    for (double z = 0.01; z < 0.15; z += step) {
+        for (double y = -0.1; y <= 0.1; y += step) pts.emplace_back(0.15, y, z);
+    }
+    for (double x = 0.0; x <= 0.15; x += step) {
+        for (double y = -0.1; y <= 0.1; y += step) pts.emplace_back(x, y, 0.15);
+    }
+    return pts;
+}
+
+TEST(AlignIcp, KeepsItsStartAlongTheOneFaceTwoViewsShare) {
+    // The views differ by 2 mm along the face's normal; the alignment starts 5 mm off along the
+    // face. The face fixes the normal; along it only the outlines pull (the point-to-point
+    // term), and outlines seen at different incidences end at different places, so the
+    // alignment keeps its start there (the turntable model's place) and finds the 2 mm across.
+    const RegistrationCloudConfig cloud_cfg;
+    const Eigen::Vector3f camera(1.0f, 0.0f, 0.6f);
+    IcpTarget target(BuildRegistrationCloud(SharedFace(), cloud_cfg, camera), 0.01);
+    const Se2 truth{0.002, 0.0, 0.0};
+    const OrientedPoints source = BuildRegistrationCloud(Move(SharedFace(), truth.Inverse()),
+                                                         cloud_cfg, truth.Inverse().Apply(camera));
+    const Se2 start{0.0, 0.005, 0.0};
+    IcpConfig fine;
+    fine.max_correspondence_m = 0.01;
+    const IcpResult r = AlignIcp(source, target, start, fine);
+    EXPECT_NEAR(r.transform.x, truth.x, 0.0005);
+    EXPECT_NEAR(r.transform.y, start.y, 0.0002);
+    // The slide is free: the face's normals fix it with a few thousandths of the information they
+    // give across it.
+    const Eigen::Matrix2d planes = r.point_scatter.topLeftCorner<2, 2>();
+    EXPECT_LT(planes(1, 1), fine.degenerate_share * planes(0, 0));
+    // Left to the outlines (nearest samples of two grids), the alignment moves along the face.
+    IcpConfig sliding = fine;
+    sliding.degenerate_share = 0.0;
+    EXPECT_GT(std::abs(AlignIcp(source, target, start, sliding).transform.y - start.y), 0.0005);
 }
 
 TEST(IcpConfig, ValidateNamesField) {
