@@ -25,8 +25,9 @@ struct IcpConfig {
     // registration_cloud.h); Geman-McClure weights with this scale damp the remaining outliers.
     double min_normal_dot = 0.9;
     double robust_scale_m = 0.004;
-    // Weight of an in-plane point-to-point term beside point-to-plane: it pulls the outlines of
-    // the faces together, which speeds the coarse alignment from afar.
+    // Weight of an in-plane point-to-point term beside point-to-plane: it pulls the faces'
+    // outlines together, in the directions the faces' planes fix too (not along a degenerate
+    // one, below).
     double point_to_point_weight = 0.3;
     // A degenerate direction: an in-plane direction that the surfaces' normals fix with less than
     // this share of the information of the best-fixed one. Two views that share one face only
@@ -34,7 +35,7 @@ struct IcpConfig {
     // and outlines seen at different incidences (a face at 30 degrees in one view, 60 in the
     // other) end at different places: dropouts at grazing, mixed pixels at the silhouette. The
     // point-to-point term then slid such alignments 8-12 mm along the face, on a station with
-    // an exact turntable, and the table's centre followed them (a box 3-8 mm small). The
+    // an exact turntable, and the table's centre followed them (a box 2-8 mm small). The
     // alignment does not move along a degenerate direction (solution remapping, Zhang, Kaess and
     // Singh 2016): it keeps the turntable model's place there, and the pose graph, to which the
     // direction's information is next to nothing, fills it from the other alignments. One face
