@@ -11,6 +11,15 @@ void RoundingEvidence::Add(double raw_fitted_depth_m, double gain, double residu
     squares_ += (residual_m / gain) * (residual_m / gain);
 }
 
+void RoundingEvidence::AddAlongRay(const Eigen::Vector3d& ray, const Eigen::Vector3d& axis,
+                                   const Eigen::Vector3d& normal, double camera_height_m,
+                                   double residual_m, const StationCalibration& calibration) {
+    const double depth = ray.dot(axis), across = normal.dot(ray);
+    if (!(depth > 0.0) || across == 0.0) return;
+    Add(calibration.RawDepth(-camera_height_m / across * depth), std::abs(across) / depth,
+        residual_m);
+}
+
 void RoundingEvidence::Finish() {
     if (!gains.empty()) depth_scatter_m = std::sqrt(squares_ / static_cast<double>(gains.size()));
     Thin(kRoundingReadings);

@@ -25,8 +25,11 @@
 // noise smaller than it is, and the bound errs wide where the frames' noise is near the unit.
 // Beyond about half a unit of noise nothing is left.
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <vector>
+
+#include "pipeline/station_calibration.h"
 
 namespace boxd {
 
@@ -47,6 +50,15 @@ struct RoundingEvidence {
     // Adds a reading: the fitted surface's raw depth along its ray, its gain (> 0) and its
     // distance from the surface along the surface's normal.
     void Add(double raw_fitted_depth_m, double gain, double residual_m);
+    // Adds the reading on `ray` (from the camera, whose optical axis is `axis`) of a surface with
+    // unit `normal` that the camera stands `camera_height_m` above (signed, along the normal),
+    // `residual_m` off it along the normal: the surface meets the ray at t = -h / (n . r), depth
+    // t (r . a), raw by `calibration`; a depth error e moves the reading along its ray by
+    // e / (r . a), across the surface by that times |n . r|. A ray behind the camera or along
+    // the surface adds nothing.
+    void AddAlongRay(const Eigen::Vector3d& ray, const Eigen::Vector3d& axis,
+                     const Eigen::Vector3d& normal, double camera_height_m, double residual_m,
+                     const StationCalibration& calibration);
     // Ends the adding: the readings' scatter, and at most kRoundingReadings of them kept.
     void Finish();
     // Keeps at most `max_readings` readings, evenly spread (the sum above is estimated from them).

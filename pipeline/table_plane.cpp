@@ -111,13 +111,8 @@ RoundingEvidence TableRounding(const std::vector<std::vector<Eigen::Vector3d>>& 
     for (const auto& pose : poses) {
         for (const Eigen::Vector3d& p : pose) {
             const double r = plane.normal.dot(p) + plane.d;
-            const Eigen::Vector3d ray = p - camera;
-            const double depth = ray.dot(axis), across = plane.normal.dot(ray);
-            if (std::abs(r) > band || !(depth > 0.0) || across == 0.0) continue;
-            // A depth error e moves the reading along its ray by e / (r . a), across the plane
-            // by that times |n . r|; the plane meets the ray at depth t (r . a).
-            out.Add(calibration.RawDepth(-camera_side / across * depth), std::abs(across) / depth,
-                    r);
+            if (std::abs(r) > band) continue;
+            out.AddAlongRay(p - camera, axis, plane.normal, camera_side, r, calibration);
         }
     }
     out.Finish();

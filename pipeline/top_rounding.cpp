@@ -10,9 +10,9 @@ RoundingEvidence TopRounding(const FusedCloud& cloud, const std::vector<Se2>& po
                              const StationCalibration& calibration, double band, double margin) {
     const Eigen::Isometry3d table_to_camera = camera_to_table.inverse();
     // The top's normal in the camera's frame, the same in every view (the table turns about
-    // it), and the camera's height under the top.
+    // it), and the camera's height above the top.
     const Eigen::Vector3d up = table_to_camera.linear().col(2);
-    const double below = cuboid.height_m - camera_to_table.translation().z();
+    const double above = camera_to_table.translation().z() - cuboid.height_m;
     const Eigen::Vector2d along = cuboid.length_axis.normalized();
     const Eigen::Vector2d across(-along.y(), along.x());
     const double half_l = 0.5 * cuboid.length_m - margin, half_w = 0.5 * cuboid.width_m - margin;
@@ -27,12 +27,8 @@ RoundingEvidence TopRounding(const FusedCloud& cloud, const std::vector<Se2>& po
         if (std::abs(xy.dot(along)) > half_l || std::abs(xy.dot(across)) > half_w) continue;
         const std::size_t k = cloud.unfiltered_view[i];
         if (k >= poses.size()) continue;
-        const Eigen::Vector3d ray = table_to_camera * into_view[k].Apply(p).cast<double>();
-        const double rise = up.dot(ray);
-        if (!(ray.z() > 0.0) || rise == 0.0) continue;
-        // A depth error e moves the reading along its ray by e / (r . a), up by that times
-        // |n . r|; the top meets the ray at depth (below / n . r) (r . a).
-        out.Add(calibration.RawDepth(below / rise * ray.z()), std::abs(rise) / ray.z(), r);
+        out.AddAlongRay(table_to_camera * into_view[k].Apply(p).cast<double>(),
+                        Eigen::Vector3d::UnitZ(), up, above, r, calibration);
     }
     out.Finish();
     return out;
