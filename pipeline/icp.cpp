@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <cmath>
+#include <optional>
 #include <vector>
 
 namespace boxd {
@@ -108,6 +109,14 @@ Linearization Linearize(const OrientedPoints& source, const IcpTarget& target, c
     return lin;
 }
 
+// The in-plane direction (x, y) the surfaces' planes leave free (IcpConfig::degenerate_share),
+// or nothing when they fix both.
+std::optional<Eigen::Vector2d> FreeDirection(const Eigen::Matrix3d& jtj, double share) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> planes(jtj.topLeftCorner<2, 2>());
+    if (!(planes.eigenvalues()(0) < share * planes.eigenvalues()(1))) return std::nullopt;
+    return Eigen::Vector2d(planes.eigenvectors().col(0));
+}
+
 }  // namespace
 
 IcpResult AlignIcp(const OrientedPoints& source, const IcpTarget& target, const Se2& init,
@@ -135,10 +144,8 @@ IcpResult AlignIcp(const OrientedPoints& source, const IcpTarget& target, const 
         Eigen::Vector3d delta = h.ldlt().solve(-g);
         if (!delta.allFinite()) break;
         // No step along a degenerate direction (IcpConfig::degenerate_share).
-        const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> planes(lin.jtj.topLeftCorner<2, 2>());
-        if (planes.eigenvalues()(0) < config.degenerate_share * planes.eigenvalues()(1)) {
-            const Eigen::Vector2d free = planes.eigenvectors().col(0);
-            delta.head<2>() -= free * free.dot(delta.head<2>());
+        if (const auto free = FreeDirection(lin.jtj, config.degenerate_share)) {
+            delta.head<2>() -= *free * free->dot(delta.head<2>());
         }
         t = Se2{delta.x(), delta.y(), delta.z()}.Compose(t);
         if (delta.head<2>().norm() < config.translation_tolerance_m &&
@@ -148,6 +155,7 @@ IcpResult AlignIcp(const OrientedPoints& source, const IcpTarget& target, const 
         }
     }
     const Linearization fin = Linearize(source, target, t, config);
+    if (const auto free = FreeDirection(fin.jtj, config.degenerate_share)) result.slide = *free;
     result.transform = t;
     result.correspondences = fin.matched;
     result.solved = fin.solved;

@@ -64,6 +64,10 @@ struct IcpResult {
     // JᵀJ / N: for a motion error e, sqrt(eᵀ S e) is the RMS displacement it causes along the
     // target normals, i.e. how much a disagreement of e actually moves the surfaces.
     Eigen::Matrix3d point_scatter = Eigen::Matrix3d::Zero();
+    // The in-plane direction the surfaces' planes leave free (IcpConfig::degenerate_share), a
+    // unit vector, or zero when they fix both: along it `transform` is its start, the turntable
+    // model's, and `information` there is the outlines' and the prior's, not the surfaces'.
+    Eigen::Vector2d slide = Eigen::Vector2d::Zero();
     bool converged = false;
     int correspondences = 0;
     // Correspondences on upright surfaces, the ones that fix (x, y, yaw); below the config's

@@ -2,7 +2,6 @@
 
 #include <ceres/ceres.h>
 
-#include <Eigen/Cholesky>
 #include <Eigen/SparseCore>
 #include <algorithm>
 #include <cmath>
@@ -103,12 +102,49 @@ private:
     double yaw_, inv_yaw_sigma_, inv_t_sigma_;
 };
 
+// The calibration's word on the table's centre: r = c / σ (PoseGraphConfig::
+// calibration_center_sigma_m), the offset from the recorded centre in sigmas.
+class CalibrationCenterCost {
+public:
+    explicit CalibrationCenterCost(double sigma) : inv_sigma_(1.0 / sigma) {}
+
+    template <typename T>
+    bool operator()(const T* center, T* residual) const {
+        residual[0] = center[0] * T(inv_sigma_);
+        residual[1] = center[1] * T(inv_sigma_);
+        return true;
+    }
+
+    static ceres::CostFunction* Create(double sigma) {
+        return new ceres::AutoDiffCostFunction<CalibrationCenterCost, 2, 2>(
+            new CalibrationCenterCost(sigma));
+    }
+
+private:
+    double inv_sigma_;
+};
+
+// Upper triangular U with UᵀU = information, so |U e|² = eᵀ I e, for an information that may be
+// singular: an alignment says nothing along the slide its surfaces leave free (icp.h), and the
+// direction must stay free here, not get a ridge's worth of information that the variance
+// components then scale up with the edge's. A pivot that vanishes (beside the trace) leaves its
+// row zero: the information's remaining rows do not depend on that direction.
 Eigen::Matrix3d SqrtInformation(const Eigen::Matrix3d& information) {
-    // Upper Cholesky factor U with UᵀU = information, so |U e|² = eᵀ I e.
-    Eigen::Matrix3d info = 0.5 * (information + information.transpose());
-    info.diagonal().array() += 1e-9 * info.trace() + 1e-12;
-    Eigen::LLT<Eigen::Matrix3d> llt(info);
-    return llt.matrixU();
+    const Eigen::Matrix3d info = 0.5 * (information + information.transpose());
+    const double tiny = 1e-9 * std::max(info.trace(), 0.0);
+    Eigen::Matrix3d u = Eigen::Matrix3d::Zero();
+    for (int i = 0; i < 3; ++i) {
+        double pivot = info(i, i);
+        for (int k = 0; k < i; ++k) pivot -= u(k, i) * u(k, i);
+        if (!(pivot > tiny)) continue;
+        u(i, i) = std::sqrt(pivot);
+        for (int j = i + 1; j < 3; ++j) {
+            double v = info(i, j);
+            for (int k = 0; k < i; ++k) v -= u(k, i) * u(k, j);
+            u(i, j) = v / u(i, i);
+        }
+    }
+    return u;
 }
 
 struct Problem {
@@ -117,7 +153,24 @@ struct Problem {
     std::unique_ptr<ceres::Problem> problem;
 };
 
-void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Problem& p) {
+// `information` knowing nothing of the motion along the in-plane direction `slide` (unit, or
+// zero for none): the information about the rest of the motion whatever the slide, the Schur
+// complement of the slide's row.
+Eigen::Matrix3d WithoutSlide(const Eigen::Matrix3d& information, const Eigen::Vector2d& slide) {
+    const Eigen::Vector3d f(slide.x(), slide.y(), 0.0);
+    const Eigen::Vector3d jf = information * f;
+    const double ff = f.dot(jf);
+    if (!(ff > 0.0)) return information;
+    return information - jf * jf.transpose() / ff;
+}
+
+// What the problem is built for: the solve, where an edge keeps its information along its slide
+// (the model's place, where the solve should keep it), or the poses' covariance, where that
+// information is the calibration's, counted once, on the centre (PoseCovariance).
+enum class Purpose { kSolve, kCovariance };
+
+void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Purpose purpose,
+                  Problem& p) {
     p.params.resize(graph.poses.size());
     for (std::size_t k = 0; k < graph.poses.size(); ++k) {
         p.params[k] = {graph.poses[k].x, graph.poses[k].y, graph.poses[k].yaw};
@@ -128,8 +181,11 @@ void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Problem
         if (e.rejected) continue;
         ceres::LossFunction* loss =
             e.loop_closure ? new ceres::HuberLoss(config.loop_huber_scale) : nullptr;
+        const Eigen::Matrix3d scatter = purpose == Purpose::kCovariance
+                                            ? WithoutSlide(e.point_scatter, e.slide)
+                                            : e.point_scatter;
         const Eigen::Matrix3d info =
-            e.point_scatter / (config.edge_displacement_sigma_m * config.edge_displacement_sigma_m);
+            scatter / (config.edge_displacement_sigma_m * config.edge_displacement_sigma_m);
         Eigen::Matrix3d sqrt_info = SqrtInformation(info) * std::sqrt(e.evidence_weight);
         for (int row = 0; row < 3; ++row) {
             sqrt_info.row(row) *= std::sqrt(e.row_weight(row)) / config.edge_part_scale[row];
@@ -144,6 +200,11 @@ void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Problem
                                        config.prior_center_sigma_m),
             nullptr, p.params[k].data(), p.center.data());
     }
+    if (purpose == Purpose::kCovariance && graph.poses.size() > 1) {
+        p.problem->AddResidualBlock(
+            CalibrationCenterCost::Create(config.calibration_center_sigma_m), nullptr,
+            p.center.data());
+    }
     // Gauge freedom: the edges only fix relative poses, so moving every pose by one rigid motion
     // leaves the cost unchanged. Pose 0 defines the frame (the table frame of pose 0 the fused
     // cloud lives in) and is held constant; its prior is not added for the same reason.
@@ -157,10 +218,11 @@ void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Problem
 
 namespace pose_graph_internal {
 
-std::optional<Linearization> Linearize(const PoseGraph& graph, const PoseGraphConfig& config) {
+std::optional<Linearization> Linearize(const PoseGraph& graph, const PoseGraphConfig& config,
+                                       bool for_covariance) {
     const int n = static_cast<int>(graph.poses.size());
     Problem p;
-    BuildProblem(graph, config, p);
+    BuildProblem(graph, config, for_covariance ? Purpose::kCovariance : Purpose::kSolve, p);
     ceres::Problem::EvaluateOptions options;
     for (int k = 1; k < n; ++k) options.parameter_blocks.push_back(p.params[k].data());
     options.parameter_blocks.push_back(p.center.data());
@@ -179,7 +241,8 @@ std::optional<Linearization> Linearize(const PoseGraph& graph, const PoseGraphCo
     out.jacobian.resize(crs.num_rows, crs.num_cols);
     out.jacobian.setFromTriplets(entries.begin(), entries.end());
     out.residuals = Eigen::Map<const Eigen::VectorXd>(residuals.data(), crs.num_rows);
-    out.edge_rows = crs.num_rows - 3 * (n - 1);
+    out.prior_rows = n > 1 ? 3 * (n - 1) : 0;
+    out.edge_rows = crs.num_rows - out.prior_rows - (for_covariance && n > 1 ? 2 : 0);
     return out;
 }
 
@@ -191,6 +254,9 @@ Status PoseGraphConfig::Validate() const {
     };
     if (!(prior_yaw_sigma_rad > 0.0)) return bad("prior_yaw_sigma_rad", "must be > 0");
     if (!(prior_center_sigma_m > 0.0)) return bad("prior_center_sigma_m", "must be > 0");
+    if (!(calibration_center_sigma_m > 0.0)) {
+        return bad("calibration_center_sigma_m", "must be > 0");
+    }
     if (!(edge_displacement_sigma_m > 0.0)) return bad("edge_displacement_sigma_m", "must be > 0");
     for (double scale : edge_part_scale) {
         if (!(scale > 0.0 && std::isfinite(scale))) return bad("edge_part_scale", "must be > 0");
@@ -220,7 +286,7 @@ double EdgeDisplacement(const PoseGraph& graph, const PoseEdge& edge) {
 Status SolvePoseGraph(PoseGraph& graph, const PoseGraphConfig& config) {
     if (graph.poses.size() < 2) return OkStatus();
     Problem p;
-    BuildProblem(graph, config, p);
+    BuildProblem(graph, config, Purpose::kSolve, p);
     ceres::Solver::Options options;
     // Sparse: each node meets only its neighbours and the centre, so a 360-pose graph solves in
     // milliseconds where a dense QR takes seconds per iteration.

@@ -17,6 +17,14 @@ struct PoseGraphConfig {
     // leave free (a box face seen face-on lets a view slide along it).
     double prior_yaw_sigma_rad = 0.5 * M_PI / 180.0;  // turntable angle error
     double prior_center_sigma_m = 0.001;
+    // How well the recorded calibration placed the table's centre (1-sigma per in-plane axis):
+    // a prior on the estimated centre offset, at this weight whatever the residuals show (they
+    // say nothing of it). Where the alignments fix the centre (most rings of views) it hardly
+    // counts; where they leave a direction of it free (four views a quarter turn apart share
+    // one face each, and every alignment leaves its slide along it to the model), the centre
+    // there, and every pose with it, is known only as well as the calibration put it, and the
+    // poses' covariance says so. `boxd calibrate` places it to a few tenths of a millimetre.
+    double calibration_center_sigma_m = 0.001;
     // Edges are weighted by their surface displacement (IcpResult::point_scatter) over this
     // sigma: ICP errors are correlated across points, so JᵀJ / sigma² would be overconfident.
     double edge_displacement_sigma_m = 0.001;
@@ -63,6 +71,10 @@ struct PoseEdge {
     // (set by the weighed solve, pose_graph_variance.cpp).
     double random_displacement_m = 0.0;
     double evidence_weight = 1.0;
+    // The in-plane direction (x, y, the `from` view's frame) along which the alignment kept its
+    // start, the turntable model's (IcpResult::slide), or zero. The solve keeps the model there;
+    // the poses' covariance counts it as unmeasured (PoseCovariance).
+    Eigen::Vector2d slide = Eigen::Vector2d::Zero();
 };
 
 // Node k's pose maps view k's points into the frame of view 0 (held constant).
@@ -96,8 +108,10 @@ Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfi
 // by its variance component estimated from its own residuals (Förstner), and each edge's rows by
 // their weights (PoseEdge::row_weight, from the weighed solve): the configured sigmas
 // only weigh the solve, the scatter the solution shows decides how well the poses are known.
-// Without redundancy (no edges: the turntable model alone) the prior's configured sigmas, per
-// node.
+// An edge counts nothing along its slide (PoseEdge::slide): there it repeated the model it
+// started from, whose centre is the calibration's, known to calibration_center_sigma_m, a prior
+// on the centre at that weight. Without redundancy (no edges: the turntable model alone) the
+// priors' configured sigmas.
 Eigen::MatrixXd PoseCovariance(const PoseGraph& graph, const PoseGraphConfig& config);
 
 // Returns the residual (x, y, yaw) of `edge` at the graph's current poses.

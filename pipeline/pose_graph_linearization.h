@@ -13,16 +13,20 @@ namespace boxd::pose_graph_internal {
 
 // The whitened residuals and their Jacobian at the graph's solution, with respect to nodes
 // 1..n-1 and the centre offset (node 0 is the gauge). The residual blocks come in BuildProblem's
-// order: the kept edges' rows, then the priors'. Each row touches at most two nodes and the
-// centre, so the Jacobian stays sparse: with 360 poses it has ~4,000 rows of 1,079 columns.
+// order: the kept edges' rows, then the priors' (and for the covariance the calibration's two on
+// the centre, with the edges counting nothing along their slides). Each row touches at most two
+// nodes and the centre, so the Jacobian stays sparse: with 360 poses it has ~4,000 rows of 1,079
+// columns.
 struct Linearization {
     Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian;
     Eigen::VectorXd residuals;
     int edge_rows = 0;
+    int prior_rows = 0;  // the turntable prior's, after the edges'
 };
 
 // Returns the linearisation at the graph's poses, or nothing when Ceres cannot evaluate it.
-std::optional<Linearization> Linearize(const PoseGraph& graph, const PoseGraphConfig& config);
+std::optional<Linearization> Linearize(const PoseGraph& graph, const PoseGraphConfig& config,
+                                       bool for_covariance = false);
 
 // Re-solves with each group of residuals (the ICP edges' three rows, the prior's translations,
 // its yaws) weighed by its variance component at the solution (pose_graph_variance.cpp), for

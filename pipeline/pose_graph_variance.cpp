@@ -1,5 +1,3 @@
-#include "pipeline/pose_graph_linearization.h"
-
 #include <spdlog/spdlog.h>
 
 #include <Eigen/SparseCholesky>
@@ -10,6 +8,7 @@
 #include <vector>
 
 #include "pipeline/pose_graph.h"
+#include "pipeline/pose_graph_linearization.h"
 
 namespace boxd {
 
@@ -62,15 +61,36 @@ Eigen::VectorXd Leverage(const Eigen::SparseMatrix<double, Eigen::RowMajor>& jac
 }
 
 // The residuals' groups, each an error source of its own: the ICP edges' three rows (the
-// translation across the camera's line of sight, along it, the yaw: RelativeCost), and the
+// translation across the camera's line of sight, along it, the yaw: RelativeCost), the
 // turntable prior's translations (how far a view sits off a pure rotation about the table's
-// centre: wobble, a loose parcel) and yaws (the table's angle error).
-enum Group { kEdgeAcross, kEdgeAlong, kEdgeYaw, kPriorTranslation, kPriorYaw, kGroups };
+// centre: wobble, a loose parcel) and yaws (the table's angle error), and the calibration's
+// centre, which keeps its configured weight: its residual is one draw of the calibration's
+// error, no scatter to estimate a variance from.
+enum Group {
+    kEdgeAcross,
+    kEdgeAlong,
+    kEdgeYaw,
+    kPriorTranslation,
+    kPriorYaw,
+    kCalibrationCenter,
+    kGroups
+};
 
 // Each row's group: edges and priors both come in threes.
 int GroupOf(const Linearization& lin, Eigen::Index r) {
     const int part = static_cast<int>(r % 3);
-    return r < lin.edge_rows ? part : (part == 2 ? kPriorYaw : kPriorTranslation);
+    if (r < lin.edge_rows) return part;
+    if (r < lin.edge_rows + lin.prior_rows) return part == 2 ? kPriorYaw : kPriorTranslation;
+    return kCalibrationCenter;
+}
+
+// Whether row `r` of `jacobian` moves with the unknowns: an edge's row along the slide its
+// alignment leaves free is zero (SqrtInformation, pose_graph.cpp), and holds no redundancy.
+bool Informative(const Eigen::SparseMatrix<double, Eigen::RowMajor>& jacobian, Eigen::Index r) {
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator a(jacobian, r); a; ++a) {
+        if (a.value() != 0.0) return true;
+    }
+    return false;
 }
 
 // The redundancy each group holds (Σ 1 − h_ii over its rows), as VarianceComponentCovariance
@@ -106,6 +126,7 @@ std::optional<Eigen::MatrixXd> VarianceComponentCovariance(
         double squares[kGroups] = {}, redundancy[kGroups] = {};
         for (Eigen::Index r = 0; r < rows; ++r) {
             const int g = group[static_cast<std::size_t>(r)];
+            if (!Informative(lin.jacobian, r)) continue;
             squares[g] += lin.residuals(r) * lin.residuals(r) / scale(r);
             redundancy[g] += 1.0 - leverage(r);
         }
@@ -116,7 +137,7 @@ std::optional<Eigen::MatrixXd> VarianceComponentCovariance(
         double factor[kGroups];
         settled = true;
         for (int g = 0; g < kGroups; ++g) {
-            factor[g] = redundancy[g] < 1.0
+            factor[g] = redundancy[g] < 1.0 || g == kCalibrationCenter
                             ? 1.0
                             : std::sqrt(std::max(squares[g] / redundancy[g], kMinVarianceFactor));
             settled = settled && std::abs(factor[g] - 1.0) < kSettledFactor;
@@ -171,7 +192,9 @@ std::array<double, kGroups> HeldRedundancyFactors(const Linearization& lin,
         squares[static_cast<std::size_t>(GroupOf(lin, r))] += lin.residuals(r) * lin.residuals(r);
     }
     for (std::size_t g = 0; g < kGroups; ++g) {
-        factor[g] = held[g] < 1.0 ? 1.0 : std::max(squares[g] / held[g], kMinVarianceFactor);
+        factor[g] = held[g] < 1.0 || g == kCalibrationCenter
+                        ? 1.0
+                        : std::max(squares[g] / held[g], kMinVarianceFactor);
     }
     return factor;
 }
@@ -194,14 +217,19 @@ Eigen::MatrixXd PoseCovariance(const PoseGraph& graph, const PoseGraphConfig& co
     Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(3 * n, 3 * n);
     if (n < 2) return cov;
     const Eigen::Index nodes = 3 * (n - 1);
-    const auto lin = pose_graph_internal::Linearize(graph, config);
-    const auto inverse = lin ? VarianceComponentCovariance(*lin) : std::nullopt;
-    if (inverse && lin->edge_rows > 0) {
+    const auto lin = pose_graph_internal::Linearize(graph, config, /*for_covariance=*/true);
+    // Without edges (the turntable model alone) nothing is redundant: each pose as well as the
+    // prior and the calibration's centre say, at their configured sigmas.
+    std::optional<Eigen::MatrixXd> inverse;
+    if (lin && lin->edge_rows > 0) inverse = VarianceComponentCovariance(*lin);
+    if (lin && !inverse) inverse = NormalInverse(lin->jacobian);
+    if (inverse) {
         cov.bottomRightCorner(nodes, nodes) = inverse->topLeftCorner(nodes, nodes);
         return cov;
     }
-    // The turntable model alone: each pose as well as the prior says.
-    const double c2 = config.prior_center_sigma_m * config.prior_center_sigma_m;
+    // Not even that (Ceres could not evaluate the graph): each pose as the prior says alone.
+    const double c2 = config.prior_center_sigma_m * config.prior_center_sigma_m +
+                      4.0 * config.calibration_center_sigma_m * config.calibration_center_sigma_m;
     const double y2 = config.prior_yaw_sigma_rad * config.prior_yaw_sigma_rad;
     for (int k = 1; k < n; ++k) cov.diagonal().segment<3>(3 * k) = Eigen::Vector3d(c2, c2, y2);
     return cov;

@@ -50,7 +50,8 @@ TurnOrder::TurnOrder(const std::vector<double>& table_angles_rad) {
         return wrapped[static_cast<std::size_t>(a)] < wrapped[static_cast<std::size_t>(b)];
     });
     rank_.resize(n);
-    for (std::size_t r = 0; r < n; ++r) rank_[static_cast<std::size_t>(at_[r])] = static_cast<int>(r);
+    for (std::size_t r = 0; r < n; ++r)
+        rank_[static_cast<std::size_t>(at_[r])] = static_cast<int>(r);
 }
 
 int TurnOrder::Neighbour(int pose, int steps) const {
@@ -101,7 +102,8 @@ std::vector<std::pair<int, int>> ViewPairs(const std::vector<double>& table_angl
     const TurnOrder order(table_angles_rad);
     std::vector<std::pair<int, int>> pairs;
     for (int j = 1; j < n; ++j) {
-        for (int i : PairedEarlierViews(j, order, table_angles_rad, config)) pairs.emplace_back(i, j);
+        for (int i : PairedEarlierViews(j, order, table_angles_rad, config))
+            pairs.emplace_back(i, j);
     }
     std::sort(pairs.begin(), pairs.end());
     return pairs;
@@ -133,6 +135,7 @@ PairAlignment AlignViewPair(int i, int j, const ViewClouds& view_j, const ViewTa
     edge.information = out.fine.information;
     edge.point_scatter = out.fine.point_scatter;
     edge.random_displacement_m = out.fine.random_displacement_m;
+    edge.slide = out.fine.slide;
     return out;
 }
 
@@ -195,9 +198,9 @@ std::vector<PoseEdge> RegisterViewPairs(const std::vector<ViewClouds>& views,
     std::vector<PairAlignment> alignments(list.size());
     ParallelFor(static_cast<int>(list.size()), config.threads, [&](int e) {
         const auto [i, j] = list[static_cast<std::size_t>(e)];
-        alignments[static_cast<std::size_t>(e)] = AlignViewPair(
-            i, j, views[static_cast<std::size_t>(j)], *targets[static_cast<std::size_t>(i)],
-            model, config);
+        alignments[static_cast<std::size_t>(e)] =
+            AlignViewPair(i, j, views[static_cast<std::size_t>(j)],
+                          *targets[static_cast<std::size_t>(i)], model, config);
     });
     std::vector<PoseEdge> edges = AcceptedEdges(alignments, config, stats);
     MarkLoopClosures(edges, table_angles_rad);

@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdio>
 #include <random>
+
+#include "pipeline/student_t.h"
 
 namespace boxd {
 namespace {
@@ -326,15 +329,81 @@ TEST(PoseCovariance, TheTablesAngleErrorDoesNotWidenWhereTheViewsSit) {
     EXPECT_LT(sigma_t[1], 6.0 * sigma_t[0]) << sigma_t[0] << " " << sigma_t[1];
 }
 
-TEST(PoseCovariance, TurntableModelAloneTakesThePriorsSigmas) {
+TEST(PoseCovariance, TurntableModelAloneTakesThePriorsAndTheCalibrationsSigmas) {
+    // No edges: view k sits where a turn by θ_k about the calibration's centre puts it, off by
+    // the prior's σ_c, and the centre is known to the calibration's σ: a turn moves a centre
+    // error δ by (I - R(θ_k)) δ, of length |δ| √(2 - 2 cos θ_k).
     Ring ring = MakeRing(4, {0.0, 0.0}, 5);
     ring.graph.edges.clear();
     PoseGraphConfig config;
     ASSERT_TRUE(OptimizePoseGraph(ring.graph, config).ok());
     const Eigen::MatrixXd cov = PoseCovariance(ring.graph, config);
+    const double c2 = config.calibration_center_sigma_m * config.calibration_center_sigma_m;
     for (Eigen::Index k = 1; k < 4; ++k) {
-        EXPECT_NEAR(std::sqrt(cov(3 * k, 3 * k)), config.prior_center_sigma_m, 1e-12);
+        const double turn = ring.graph.poses[static_cast<std::size_t>(k)].yaw;
+        const double expected =
+            std::sqrt(config.prior_center_sigma_m * config.prior_center_sigma_m +
+                      c2 * (2.0 - 2.0 * std::cos(turn)));
+        EXPECT_NEAR(std::sqrt(cov(3 * k, 3 * k)), expected, 1e-9) << "pose " << k;
+        EXPECT_NEAR(std::sqrt(cov(3 * k + 1, 3 * k + 1)), expected, 1e-9) << "pose " << k;
         EXPECT_NEAR(std::sqrt(cov(3 * k + 2, 3 * k + 2)), config.prior_yaw_sigma_rad, 1e-12);
+    }
+}
+
+// Four views a quarter turn apart on a table whose recorded centre is 1.5 mm off: each pair of
+// neighbours shares one face, which fixes their motion across it and leaves the slide along it
+// (120 degrees, the same in every pair's frame) to the turntable model, about the recorded
+// centre. One direction of the centre then shows in no alignment.
+Ring QuarterTurnsSharingOneFace(bool slides_marked) {
+    const Eigen::Vector2d center(0.0005, 0.0014);
+    Ring ring = MakeRing(4, center, 11, 0.00005);
+    const Eigen::Vector2d slide(std::cos(120.0 * kDeg), std::sin(120.0 * kDeg));
+    const Eigen::Vector2d across(-slide.y(), slide.x());
+    std::vector<PoseEdge> kept;
+    for (PoseEdge e : ring.graph.edges) {
+        if (e.loop_closure && (e.to - e.from + 4) % 4 != 1) continue;  // neighbours only
+        // Along the slide the alignment kept its start: the model's motion about the recorded
+        // centre, a pure turn about the origin, with no translation.
+        const Eigen::Vector2d t(e.measured.x, e.measured.y);
+        const Eigen::Vector2d kept_t = across * across.dot(t);
+        e.measured = Se2{kept_t.x(), kept_t.y(), e.measured.yaw};
+        Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+        scatter.topLeftCorner<2, 2>() =
+            0.5 * across * across.transpose() + 0.001 * slide * slide.transpose();
+        scatter(2, 2) = 0.04;
+        e.point_scatter = scatter;
+        e.information = scatter / 1e-8;
+        e.loop_closure = false;
+        if (slides_marked) e.slide = slide;
+        kept.push_back(e);
+    }
+    ring.graph.edges = kept;
+    return ring;
+}
+
+TEST(PoseCovariance, ADirectionNoAlignmentFixesIsKnownAsWellAsTheCalibration) {
+    // The view half a turn away moves by twice the centre's error where the alignments are
+    // silent: about 3 mm. The solve keeps the recorded centre there (what else could it
+    // keep); the covariance must say it is known to 2 σ of the calibration, not to the edges'
+    // hundredths of a millimetre, which along their slides only repeat the model.
+    for (const double sigma : {0.001, 0.003}) {
+        for (const bool marked : {true, false}) {
+            Ring ring = QuarterTurnsSharingOneFace(marked);
+            PoseGraphConfig config;
+            config.calibration_center_sigma_m = sigma;
+            ASSERT_TRUE(OptimizePoseGraph(ring.graph, config).ok());
+            const Eigen::MatrixXd cov = PoseCovariance(ring.graph, config);
+            const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> t(cov.block<2, 2>(6, 6));
+            const double widest = std::sqrt(t.eigenvalues()(1));
+            const double error = Se2Difference(ring.graph.poses[2], ring.truth[2]).head<2>().norm();
+            if (marked) {
+                EXPECT_NEAR(widest, 2.0 * sigma, 0.25 * sigma) << "sigma " << sigma;
+                EXPECT_LT(error, kNormal95 * widest) << "sigma " << sigma;
+            } else {
+                // Counted as measured, the slides would vouch for the recorded centre.
+                EXPECT_LT(widest, 0.25 * error) << "sigma " << sigma;
+            }
+        }
     }
 }
 
