@@ -70,7 +70,8 @@ double FillRatio(const envelope::Surface& surface, const EnclosingCuboid& c,
 // made a sixth of its cells and read it irregular (0.84); by readings it reads 1.00, the
 // suite's boxes and parcels 0.99-1.00, its lying tubes 0.58-0.64, bags 0.43-0.73, open flaps
 // 0.12-0.36.
-double TopCover(const envelope::Surface& surface, double height, const EnvelopeConfig& config) {
+double TopCover(const envelope::Surface& surface, double height, double sigma,
+                const EnvelopeConfig& config) {
     const double cell = config.fill_cell_m;
     std::map<std::pair<int, int>, std::pair<int, float>> cells;  // readings, highest z
     for (const Eigen::Vector3f& p : surface.points) {
@@ -79,7 +80,7 @@ double TopCover(const envelope::Surface& surface, double height, const EnvelopeC
         ++c.first;
         c.second = std::max(c.second, p.z());
     }
-    const double floor = height - std::max(config.top_band * height, 0.01);
+    const double floor = height - std::max(config.top_band * height, config.layer_sigmas * sigma);
     long readings = 0, top = 0;
     for (const auto& [key, c] : cells) {
         if (c.first < config.fill_cell_points) continue;
@@ -183,7 +184,7 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
         c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u,
                      fit.top_observed ? face_sigma(4) : top_se};
         c.fill = FillRatio(shape, c, config);
-        c.top_cover = TopCover(shape, c.height_m, config);
+        c.top_cover = TopCover(shape, c.height_m, sigma, config);
         // A flat face stands where every view sees it, up to the views' registration; a curved
         // "face" (a tube's side) stands where each view's tangent is.
         double spread = 0.0;
@@ -211,7 +212,7 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     c->cuboid = false;
     c->max_relative_excess = face_excess;
     c->fill = FillRatio(shape, *c, config);
-    c->top_cover = TopCover(shape, c->height_m, config);
+    c->top_cover = TopCover(shape, c->height_m, sigma, config);
     return c;
 }
 

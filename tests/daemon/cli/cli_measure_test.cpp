@@ -154,6 +154,26 @@ TEST(CliMeasure, FourPosesOnATableCalibratedToAMillimetreAreWithinTheirBounds) {
     }
 }
 
+TEST(CliMeasure, ASixCentimetreTubeLyingOnItsSideIsIrregular) {
+    // Its top is a crest 30 mm round: the top band must be the noise's outer layer, not a
+    // fixed centimetre, or most of its footprint reads as "top" (a cover of 0.92-0.95) and the
+    // tube a cuboid, its width read off its flanks' mean planes (in 18 poses 2.2 mm small
+    // against a 0.4 mm bound).
+    TempDir dir;
+    for (const std::string seed : {"4", "5"}) {
+        const json j = Measure(
+            Synth(dir, "tube" + seed,
+                  {"--shape", "lying_cylinder", "--dims", "0.3", "0.06", "0.06", "--seed", seed}),
+            0);
+        ASSERT_EQ(j["status"], "ok") << seed;
+        EXPECT_EQ(j["shape"], "irregular") << seed;
+        EXPECT_LT(j["quality"]["top_cover"].get<double>(), 0.9) << seed;
+        EXPECT_NEAR(j["dimensions"]["length_m"].get<double>(), 0.3, 0.003) << seed;
+        EXPECT_NEAR(j["dimensions"]["width_m"].get<double>(), 0.06, 0.003) << seed;
+        EXPECT_NEAR(j["dimensions"]["height_m"].get<double>(), 0.06, 0.003) << seed;
+    }
+}
+
 TEST(CliMeasure, ATubeIsIrregularAndTwoParcelsAreRefused) {
     TempDir dir;
     const auto tube = Synth(
