@@ -272,30 +272,27 @@ Result<StationConfig> ParseStationConfig(const YAML::Node& document) {
     return config;
 }
 
-namespace {
-
-// Returns the YAML document at `path` (`what` names it in the error: "config", "calibration").
-Result<YAML::Node> LoadYaml(const std::filesystem::path& path, const std::string& what) {
+Result<YAML::Node> LoadYamlFile(const std::filesystem::path& path, const std::string& what) {
     try {
         return YAML::LoadFile(path.string());
     } catch (const YAML::BadFile&) {
-        return Error{ErrorCode::kInvalidInput, path.string() + ": cannot read the " + what + " file"};
+        return Error{ErrorCode::kInvalidInput,
+                     path.string() + ": cannot read the " + what + " file"};
     } catch (const YAML::Exception& e) {
         return Error{ErrorCode::kInvalidInput,
                      path.string() + ": line " + std::to_string(e.mark.line + 1) + ": " + e.msg};
     }
 }
 
-}  // namespace
-
 Result<StationCalibration> LoadCalibrationFile(const std::filesystem::path& path) {
-    auto root = LoadYaml(path, "calibration");
+    auto root = LoadYamlFile(path, "calibration");
     if (!root) return root.error();
     const YAML::Node& doc = *root;  // const: lookups must not add keys
     if (!doc.IsMap() || !doc["calibration"]) {
         return Error{ErrorCode::kInvalidInput,
-                     path.string() + ": calibration: missing (a file written by `boxd calibrate "
-                                     "--out`, or a station config, holds a calibration: section)"};
+                     path.string() +
+                         ": calibration: missing (a file written by `boxd calibrate "
+                         "--out`, or a station config, holds a calibration: section)"};
     }
     auto c = ParseCalibration(doc["calibration"]);
     if (!c) return Error{ErrorCode::kInvalidInput, path.string() + ": " + c.error().message};
@@ -303,7 +300,7 @@ Result<StationCalibration> LoadCalibrationFile(const std::filesystem::path& path
 }
 
 Result<StationConfig> LoadStationConfig(const std::filesystem::path& path) {
-    auto root = LoadYaml(path, "config");
+    auto root = LoadYamlFile(path, "config");
     if (!root) return root.error();
     auto config = ParseStationConfig(*root);
     if (!config)

@@ -49,9 +49,13 @@ Result<StationCalibration> ParseCalibration(const YAML::Node& node);
 // and the field when it cannot be read or holds no valid calibration.
 Result<StationCalibration> LoadCalibrationFile(const std::filesystem::path& path);
 
+// Returns the YAML document at `path`; INVALID_INPUT naming the file (and the line of a syntax
+// error) when it cannot be read ("cannot read the <what> file").
+Result<YAML::Node> LoadYamlFile(const std::filesystem::path& path, const std::string& what);
+
 // Top-level sections that belong to other parts of boxd (the daemon's) and are skipped here.
-inline const std::vector<std::string> kOtherConfigSections = {
-    "server", "storage", "mqtt", "pipeline", "measurement", "logging"};
+inline const std::vector<std::string> kOtherConfigSections = {"server", "storage", "mqtt",
+                                                              "measurement"};
 
 struct StationConfig {
     TurntableConfig turntable;

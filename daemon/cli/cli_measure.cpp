@@ -5,11 +5,12 @@
 #include <optional>
 
 #include "daemon/cli/cli.h"
+#include "daemon/service/daemon_config.h"
 #include "drivers/station_config.h"
+#include "pipeline/json_text.h"
 #include "pipeline/measure_pipeline.h"
 #include "pipeline/ply_writer.h"
 #include "pipeline/session_io.h"
-#include "pipeline/json_text.h"
 
 namespace boxd::cli {
 
@@ -20,6 +21,7 @@ struct MeasureOptions {
     std::string method = "footprint";
     std::string cloud;
     std::string calibration;
+    std::string config;
     std::optional<std::string> parcel_id;
 };
 
@@ -37,10 +39,19 @@ int RunMeasure(const MeasureOptions& opt) {
         // A station recalibrated after the capture: its calibration replaces the session's.
         auto calibration = LoadCalibrationFile(opt.calibration);
         if (!calibration) {
-            return Fail(Error{ErrorCode::kInvalidInput,
-                              "--calibration: " + calibration.error().message});
+            return Fail(
+                Error{ErrorCode::kInvalidInput, "--calibration: " + calibration.error().message});
         }
         session->calibration = *calibration;
+    }
+    MeasureConfig config;
+    if (!opt.config.empty()) {
+        // The station's `measurement:` settings, as its daemon measures with them.
+        auto loaded = LoadMeasurementConfig(opt.config);
+        if (!loaded) {
+            return Fail(Error{ErrorCode::kInvalidInput, "--config: " + loaded.error().message});
+        }
+        config = *loaded;
     }
     const BoxMethod method = opt.method == "pca" ? BoxMethod::kPca : BoxMethod::kFootprint;
     // The command line is an edge of the pipeline: it owns the id, the timestamps and the clock.
@@ -50,7 +61,7 @@ int RunMeasure(const MeasureOptions& opt) {
     const PoseFrameSource frames = [&](std::size_t pose) {
         return LoadPoseFrames(opt.session, *session, pose);
     };
-    auto out = MeasureFromSource(*session, frames, MeasureConfig{}, method, clock);
+    auto out = MeasureFromSource(*session, frames, config, method, clock);
     if (!out) return Fail(out.error());
     MeasurementResult& result = out->result;
     result.id = "offline";
@@ -92,6 +103,9 @@ void AddMeasure(CLI::App& app, Runner& run) {
     sub->add_option("--calibration", opt->calibration,
                     "a calibration file (what `boxd calibrate --out` writes): replaces the "
                     "session's calibration block");
+    sub->add_option("--config", opt->config,
+                    "a station config file: its `measurement:` section (max_uncertainty_m, "
+                    "calibration_center_sigma_m) replaces the defaults");
     sub->add_option("--parcel-id", opt->parcel_id,
                     "the parcel's id (e.g. its scanned barcode: 1 to 64 printable ASCII "
                     "characters), kept in the result as parcel_id");

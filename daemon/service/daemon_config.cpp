@@ -7,6 +7,8 @@
 #include <charconv>
 #include <set>
 
+#include "drivers/station_config.h"
+
 namespace boxd {
 
 namespace {
@@ -89,8 +91,8 @@ Status ServerConfig::Validate() const {
     }
     if (unix_socket_mode.size() < 3 || unix_socket_mode.size() > 4 ||
         unix_socket_mode.find_first_not_of("01234567") != std::string::npos) {
-        return ConfigError("server.unix_socket_mode", "'" + unix_socket_mode +
-                                                          "' is not an octal mode such as 0660");
+        return ConfigError("server.unix_socket_mode",
+                           "'" + unix_socket_mode + "' is not an octal mode such as 0660");
     }
     if (protect_reads && bearer_token.empty()) {
         return ConfigError("server.protect_reads", "needs server.bearer_token");
@@ -119,8 +121,7 @@ Status MqttConfig::Validate() const {
     if (port < 0 || port > 65535) return ConfigError("mqtt.port", "must be in 0..65535");
     if (station_id.empty() || station_id.size() > 64 ||
         !std::all_of(station_id.begin(), station_id.end(), [](char c) {
-            return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' ||
-                   c == '-';
+            return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
         })) {
         return ConfigError("mqtt.station_id",
                            "must be 1 to 64 letters, digits, '.', '_' or '-' (it names topics)");
@@ -187,6 +188,45 @@ Result<StorageConfig> ParseStorageConfig(const YAML::Node& node) {
     return c;
 }
 
+Status ParseMeasurementConfig(const YAML::Node& node, MeasureConfig& config) {
+    if (!node || node.IsNull()) return OkStatus();
+    if (auto s =
+            CheckKeys(node, "measurement", {"max_uncertainty_m", "calibration_center_sigma_m"});
+        !s) {
+        return s;
+    }
+    MeasureConfig c = config;
+    for (Status s : {ReadKey(node, "measurement", "max_uncertainty_m", c.refusal.max_uncertainty_m),
+                     ReadKey(node, "measurement", "calibration_center_sigma_m",
+                             c.pose_graph.calibration_center_sigma_m)}) {
+        if (!s) return s;
+    }
+    if (!(c.refusal.max_uncertainty_m > 0.0 && c.refusal.max_uncertainty_m <= 1.0)) {
+        return ConfigError("measurement.max_uncertainty_m", "must be in (0, 1] metres");
+    }
+    if (!(c.pose_graph.calibration_center_sigma_m > 0.0 &&
+          c.pose_graph.calibration_center_sigma_m <= 0.1)) {
+        return ConfigError("measurement.calibration_center_sigma_m", "must be in (0, 0.1] metres");
+    }
+    config = c;
+    return OkStatus();
+}
+
+Result<MeasureConfig> LoadMeasurementConfig(const std::filesystem::path& file) {
+    auto fail = [&file](const std::string& what) {
+        return Error{ErrorCode::kInvalidInput, file.string() + ": " + what};
+    };
+    auto loaded = LoadYamlFile(file, "config");
+    if (!loaded) return loaded.error();
+    const YAML::Node& root = *loaded;
+    if (!root.IsMap()) return fail("must be a map of sections");
+    MeasureConfig config;
+    if (Status s = ParseMeasurementConfig(root["measurement"], config); !s) {
+        return fail(s.error().message);
+    }
+    return config;
+}
+
 Result<MqttConfig> ParseMqttConfig(const YAML::Node& node) {
     MqttConfig c;
     if (!node || node.IsNull()) return c;
@@ -197,16 +237,15 @@ Result<MqttConfig> ParseMqttConfig(const YAML::Node& node) {
         return s.error();
     }
     c.enabled = true;
-    for (Status s : {ReadKey(node, "mqtt", "host", c.host),
-                     ReadKey(node, "mqtt", "port", c.port),
-                     ReadKey(node, "mqtt", "station_id", c.station_id),
-                     ReadKey(node, "mqtt", "username", c.username),
-                     ReadKey(node, "mqtt", "password", c.password),
-                     ReadKey(node, "mqtt", "tls", c.tls),
-                     ReadKey(node, "mqtt", "tls_ca_file", c.tls_ca_file),
-                     ReadKey(node, "mqtt", "keepalive_s", c.keepalive_s),
-                     ReadKey(node, "mqtt", "queue_limit", c.queue_limit),
-                     ReadKey(node, "mqtt", "reconnect_max_s", c.reconnect_max_s)}) {
+    for (Status s :
+         {ReadKey(node, "mqtt", "host", c.host), ReadKey(node, "mqtt", "port", c.port),
+          ReadKey(node, "mqtt", "station_id", c.station_id),
+          ReadKey(node, "mqtt", "username", c.username),
+          ReadKey(node, "mqtt", "password", c.password), ReadKey(node, "mqtt", "tls", c.tls),
+          ReadKey(node, "mqtt", "tls_ca_file", c.tls_ca_file),
+          ReadKey(node, "mqtt", "keepalive_s", c.keepalive_s),
+          ReadKey(node, "mqtt", "queue_limit", c.queue_limit),
+          ReadKey(node, "mqtt", "reconnect_max_s", c.reconnect_max_s)}) {
         if (!s) return s.error();
     }
     if (auto s = c.Validate(); !s) return s.error();

@@ -1,11 +1,13 @@
 #pragma once
-// The daemon's own config sections (`server:` and `storage:` in the YAML file), validated at
-// start: a bad value names its key ("server.listen: ...") and stops the start.
+// The daemon's own config sections (`server:`, `storage:`, `mqtt:` and `measurement:` in the YAML
+// file), validated at start: a bad value names its key ("server.listen: ...") and stops the
+// start.
 
 #include <cstddef>
 #include <filesystem>
 #include <string>
 
+#include "pipeline/measure_config.h"
 #include "pipeline/result.h"
 
 namespace YAML {
@@ -58,16 +60,16 @@ struct StorageConfig {
 // The `mqtt:` section: publish every finished measurement and the state to a broker (a fleet's
 // message bus). Absent: nothing is published.
 struct MqttConfig {
-    bool enabled = false;     // the section is present
-    std::string host;         // the broker
-    int port = 0;             // 0: 1883, or 8883 with tls
-    std::string station_id;   // topics boxd/<station_id>/...: letters, digits, '.', '_', '-'
-    std::string username;     // optional
-    std::string password;     // optional, needs username
-    bool tls = false;         // TLS to the broker, checked against the system's CAs ...
-    std::string tls_ca_file;  // ... or this CA file
-    int keepalive_s = 30;     // the broker declares the station offline after 1.5 times this
-    int queue_limit = 1000;   // measurements kept while the broker is away (then the oldest go)
+    bool enabled = false;      // the section is present
+    std::string host;          // the broker
+    int port = 0;              // 0: 1883, or 8883 with tls
+    std::string station_id;    // topics boxd/<station_id>/...: letters, digits, '.', '_', '-'
+    std::string username;      // optional
+    std::string password;      // optional, needs username
+    bool tls = false;          // TLS to the broker, checked against the system's CAs ...
+    std::string tls_ca_file;   // ... or this CA file
+    int keepalive_s = 30;      // the broker declares the station offline after 1.5 times this
+    int queue_limit = 1000;    // measurements kept while the broker is away (then the oldest go)
     int reconnect_max_s = 60;  // reconnect backoff: 1 s, doubling up to this
 
     // Returns an error naming the first invalid field ("mqtt.<field>: ..."), or Ok.
@@ -84,5 +86,15 @@ Result<ServerConfig> ParseServerConfig(const YAML::Node& node);
 Result<StorageConfig> ParseStorageConfig(const YAML::Node& node);
 // Same for the `mqtt:` section (absent or null: not enabled).
 Result<MqttConfig> ParseMqttConfig(const YAML::Node& node);
+// Sets what the `measurement:` section gives of `config` (absent or null: nothing): the
+// station's word on what the measurement may assume and report. `max_uncertainty_m` (a larger
+// 95% bound is refused UNCERTAIN) and `calibration_center_sigma_m` (how well the station's
+// calibration placed the table's centre: where no alignment fixes the centre, the bounds rest on
+// it; pipeline/pose_graph.h).
+Status ParseMeasurementConfig(const YAML::Node& node, MeasureConfig& config);
+// Returns the defaults with the `measurement:` section of the config file at `file` applied
+// (what `boxd measure --config` replays a station's sessions with). INVALID_INPUT naming the
+// file and the key when it cannot be read or a value is wrong.
+Result<MeasureConfig> LoadMeasurementConfig(const std::filesystem::path& file);
 
 }  // namespace boxd

@@ -9,14 +9,9 @@ Result<ServeConfig> LoadServeConfig(const std::filesystem::path& file,
     auto fail = [&file](const std::string& what) {
         return Error{ErrorCode::kInvalidInput, file.string() + ": " + what};
     };
-    YAML::Node root;
-    try {
-        root = YAML::LoadFile(file.string());
-    } catch (const YAML::BadFile&) {
-        return fail("cannot read the config file");
-    } catch (const YAML::Exception& e) {
-        return fail("line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
-    }
+    auto loaded = LoadYamlFile(file, "config");
+    if (!loaded) return loaded.error();
+    const YAML::Node& root = *loaded;
     if (!root.IsMap()) return fail("must be a map of sections");
 
     ServeConfig config;
@@ -33,6 +28,9 @@ Result<ServeConfig> LoadServeConfig(const std::filesystem::path& file,
     if (!station) return fail(station.error().message);
     config.station.station = std::move(*station);
     config.station.config_file = std::filesystem::absolute(file);
+    if (Status s = ParseMeasurementConfig(root["measurement"], config.station.measure); !s) {
+        return fail(s.error().message);
+    }
     if (Status s = config.station.measure.Validate(); !s) return fail(s.error().message);
 
     // The command line wins over the file, and is validated the same way.

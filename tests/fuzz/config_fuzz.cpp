@@ -1,5 +1,5 @@
 // libFuzzer target: the config loader of `boxd serve` (YAML: server, storage, turntable, camera,
-// capture, calibration, refusal). An input is the text of the config file. LoadServeConfig must
+// capture, calibration, measurement). An input is the text of the config file. LoadServeConfig must
 // return a config or an INVALID_INPUT error naming the key: never crash or hang.
 
 #include <cstddef>

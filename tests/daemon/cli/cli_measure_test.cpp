@@ -174,6 +174,40 @@ TEST(CliMeasure, ASixCentimetreTubeLyingOnItsSideIsIrregular) {
     }
 }
 
+TEST(CliMeasure, TheStationsMeasurementSectionSetsTheRefusalAndTheCalibrationsSigma) {
+    // Four poses a quarter turn apart leave one direction of the table's centre to the
+    // calibration: their footprints' bounds scale with how well the station says it is
+    // calibrated, and a limit below them refuses the box UNCERTAIN.
+    TempDir dir;
+    const auto session = Synth(dir, "four",
+                               {"--dims", "0.4", "0.3", "0.25", "--angles", "0,90,180,270", "--yaw",
+                                "30", "--seed", "7", "--calib-center-error-m", "0.001"});
+    auto bound_with = [&](const std::string& yaml, int expected_exit) {
+        const auto file = dir / "station.yaml";
+        std::ofstream(file) << yaml;
+        return Measure(session, expected_exit, {"--config", file.string()});
+    };
+    const json one = bound_with("measurement:\n  calibration_center_sigma_m: 0.001\n", 0);
+    const json three = bound_with("measurement:\n  calibration_center_sigma_m: 0.003\n", 0);
+    ASSERT_EQ(one["status"], "ok");
+    ASSERT_EQ(three["status"], "ok");
+    const double l1 = one["uncertainty_m"]["length_m"].get<double>();
+    const double l3 = three["uncertainty_m"]["length_m"].get<double>();
+    EXPECT_GT(l3, 1.8 * l1) << l1 << " " << l3;
+    // The same dimensions: the setting weighs the bound, not the solve.
+    EXPECT_EQ(one["dimensions"]["length_m"], three["dimensions"]["length_m"]);
+
+    const json refused = bound_with("measurement:\n  max_uncertainty_m: 0.001\n", 3);
+    EXPECT_EQ(refused["status"], "no_dim");
+    EXPECT_EQ(refused["reason"]["code"], "UNCERTAIN");
+
+    const auto file = dir / "typo.yaml";
+    std::ofstream(file) << "measurement:\n  max_uncertainty: 0.001\n";
+    const auto r = RunBoxd({"measure", "--session", session.string(), "--config", file.string()});
+    EXPECT_EQ(r.exit_code, 2);
+    EXPECT_NE(r.err.find("measurement.max_uncertainty: unknown key"), std::string::npos) << r.err;
+}
+
 TEST(CliMeasure, ATubeIsIrregularAndTwoParcelsAreRefused) {
     TempDir dir;
     const auto tube = Synth(

@@ -14,8 +14,8 @@
 #include <thread>
 #include <vector>
 
-#include "tests/support/run_command.h"
 #include "tests/support/prometheus_text.h"
+#include "tests/support/run_command.h"
 #include "tests/support/serve_daemon.h"
 #include "tests/support/temp_dir.h"
 
@@ -68,6 +68,10 @@ TEST(ServeConfig, BadValuesNameTheKeyAndExitWith2) {
         {"storage", "keep_sessions", "maybe", "storage.keep_sessions"},
         {"turntable", "driver", "carousel", "turntable.driver"},
         {"capture", "frames_per_pose", "0", "capture.frames_per_pose"},
+        {"measurement", "max_uncertainty_m", "0", "measurement.max_uncertainty_m"},
+        {"measurement", "calibration_center_sigma_m", "x",
+         "measurement.calibration_center_sigma_m"},
+        {"measurement", "max_uncertainty", "0.01", "measurement.max_uncertainty"},
     };
     for (const auto& c : cases) {
         YAML::Node root = YAML::LoadFile(kSimConfig.string());
@@ -92,7 +96,8 @@ TEST(ServeConfig, BadValuesNameTheKeyAndExitWith2) {
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     const std::string server = "server:\n";
     ASSERT_NE(text.find(server), std::string::npos);
-    text.insert(text.find(server) + server.size(), "  max_body_bytes: 65536\n  max_body_bytes: 1024\n");
+    text.insert(text.find(server) + server.size(),
+                "  max_body_bytes: 65536\n  max_body_bytes: 1024\n");
     std::ofstream(dir / "twice.yaml") << text;
     auto twice = test::RunBoxd({"serve", "--config", (dir / "twice.yaml").string(), "--data-dir",
                                 (dir / "data").string()});
@@ -129,8 +134,8 @@ TEST(ServeSimStation, MeasuresTheSimulatedBoxAndServesItAcrossKill9) {
         ASSERT_TRUE(none);
         EXPECT_EQ(none->status, 404);
 
-        auto res = client.Post("/v1/measure?wait=1", R"({"parcel_id": "PKG-0042"})",
-                               "application/json");
+        auto res =
+            client.Post("/v1/measure?wait=1", R"({"parcel_id": "PKG-0042"})", "application/json");
         ASSERT_TRUE(res) << httplib::to_string(res.error());
         ASSERT_EQ(res->status, 200) << res->body;
         first = json::parse(res->body);
