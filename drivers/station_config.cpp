@@ -272,6 +272,9 @@ Result<StationConfig> ParseStationConfig(const YAML::Node& document) {
     return config;
 }
 
+namespace {
+
+// Returns the YAML document at `path` (`what` names it in the error: "config", "calibration").
 Result<YAML::Node> LoadYamlFile(const std::filesystem::path& path, const std::string& what) {
     try {
         return YAML::LoadFile(path.string());
@@ -282,6 +285,16 @@ Result<YAML::Node> LoadYamlFile(const std::filesystem::path& path, const std::st
         return Error{ErrorCode::kInvalidInput,
                      path.string() + ": line " + std::to_string(e.mark.line + 1) + ": " + e.msg};
     }
+}
+
+}  // namespace
+
+Result<YAML::Node> LoadConfigSections(const std::filesystem::path& path) {
+    auto root = LoadYamlFile(path, "config");
+    if (root && !root->IsMap()) {
+        return Error{ErrorCode::kInvalidInput, path.string() + ": must be a map of sections"};
+    }
+    return root;
 }
 
 Result<StationCalibration> LoadCalibrationFile(const std::filesystem::path& path) {

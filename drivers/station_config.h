@@ -49,9 +49,9 @@ Result<StationCalibration> ParseCalibration(const YAML::Node& node);
 // and the field when it cannot be read or holds no valid calibration.
 Result<StationCalibration> LoadCalibrationFile(const std::filesystem::path& path);
 
-// Returns the YAML document at `path`; INVALID_INPUT naming the file (and the line of a syntax
-// error) when it cannot be read ("cannot read the <what> file").
-Result<YAML::Node> LoadYamlFile(const std::filesystem::path& path, const std::string& what);
+// Returns the config file at `path`, a YAML map of sections; INVALID_INPUT naming the file (and
+// the line of a syntax error) when it cannot be read or is not a map.
+Result<YAML::Node> LoadConfigSections(const std::filesystem::path& path);
 
 // Top-level sections that belong to other parts of boxd (the daemon's) and are skipped here.
 inline const std::vector<std::string> kOtherConfigSections = {"server", "storage", "mqtt",

@@ -213,16 +213,11 @@ Status ParseMeasurementConfig(const YAML::Node& node, MeasureConfig& config) {
 }
 
 Result<MeasureConfig> LoadMeasurementConfig(const std::filesystem::path& file) {
-    auto fail = [&file](const std::string& what) {
-        return Error{ErrorCode::kInvalidInput, file.string() + ": " + what};
-    };
-    auto loaded = LoadYamlFile(file, "config");
-    if (!loaded) return loaded.error();
-    const YAML::Node& root = *loaded;
-    if (!root.IsMap()) return fail("must be a map of sections");
+    auto root = LoadConfigSections(file);
+    if (!root) return root.error();
     MeasureConfig config;
-    if (Status s = ParseMeasurementConfig(root["measurement"], config); !s) {
-        return fail(s.error().message);
+    if (Status s = ParseMeasurementConfig((*root)["measurement"], config); !s) {
+        return Error{ErrorCode::kInvalidInput, file.string() + ": " + s.error().message};
     }
     return config;
 }

@@ -9,10 +9,9 @@ Result<ServeConfig> LoadServeConfig(const std::filesystem::path& file,
     auto fail = [&file](const std::string& what) {
         return Error{ErrorCode::kInvalidInput, file.string() + ": " + what};
     };
-    auto loaded = LoadYamlFile(file, "config");
+    auto loaded = LoadConfigSections(file);
     if (!loaded) return loaded.error();
     const YAML::Node& root = *loaded;
-    if (!root.IsMap()) return fail("must be a map of sections");
 
     ServeConfig config;
     auto server = ParseServerConfig(root["server"]);
