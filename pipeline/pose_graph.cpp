@@ -14,6 +14,8 @@ namespace boxd {
 
 namespace {
 
+using pose_graph_internal::Purpose;
+
 template <typename T>
 T NormalizeAngle(const T& a) {
     const T two_pi(2.0 * M_PI);
@@ -164,11 +166,6 @@ Eigen::Matrix3d WithoutSlide(const Eigen::Matrix3d& information, const Eigen::Ve
     return information - jf * jf.transpose() / ff;
 }
 
-// What the problem is built for: the solve, where an edge keeps its information along its slide
-// (the model's place, where the solve should keep it), or the poses' covariance, where that
-// information is the calibration's, counted once, on the centre (PoseCovariance).
-enum class Purpose { kSolve, kCovariance };
-
 void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Purpose purpose,
                   Problem& p) {
     p.params.resize(graph.poses.size());
@@ -219,10 +216,10 @@ void BuildProblem(const PoseGraph& graph, const PoseGraphConfig& config, Purpose
 namespace pose_graph_internal {
 
 std::optional<Linearization> Linearize(const PoseGraph& graph, const PoseGraphConfig& config,
-                                       bool for_covariance) {
+                                       Purpose purpose) {
     const int n = static_cast<int>(graph.poses.size());
     Problem p;
-    BuildProblem(graph, config, for_covariance ? Purpose::kCovariance : Purpose::kSolve, p);
+    BuildProblem(graph, config, purpose, p);
     ceres::Problem::EvaluateOptions options;
     for (int k = 1; k < n; ++k) options.parameter_blocks.push_back(p.params[k].data());
     options.parameter_blocks.push_back(p.center.data());
@@ -242,7 +239,8 @@ std::optional<Linearization> Linearize(const PoseGraph& graph, const PoseGraphCo
     out.jacobian.setFromTriplets(entries.begin(), entries.end());
     out.residuals = Eigen::Map<const Eigen::VectorXd>(residuals.data(), crs.num_rows);
     out.prior_rows = n > 1 ? 3 * (n - 1) : 0;
-    out.edge_rows = crs.num_rows - out.prior_rows - (for_covariance && n > 1 ? 2 : 0);
+    out.edge_rows =
+        crs.num_rows - out.prior_rows - (purpose == Purpose::kCovariance && n > 1 ? 2 : 0);
     return out;
 }
 

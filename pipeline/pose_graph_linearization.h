@@ -24,9 +24,14 @@ struct Linearization {
     int prior_rows = 0;  // the turntable prior's, after the edges'
 };
 
+// What the problem is built for: the solve, where an edge keeps its information along its slide
+// (the model's place, where the solve should keep it), or the poses' covariance, where that
+// information is the calibration's, counted once, on the centre (PoseCovariance).
+enum class Purpose { kSolve, kCovariance };
+
 // Returns the linearisation at the graph's poses, or nothing when Ceres cannot evaluate it.
 std::optional<Linearization> Linearize(const PoseGraph& graph, const PoseGraphConfig& config,
-                                       bool for_covariance = false);
+                                       Purpose purpose = Purpose::kSolve);
 
 // Re-solves with each group of residuals (the ICP edges' three rows, the prior's translations,
 // its yaws) weighed by its variance component at the solution (pose_graph_variance.cpp), for

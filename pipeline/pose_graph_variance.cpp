@@ -111,8 +111,11 @@ std::optional<Eigen::MatrixXd> VarianceComponentCovariance(
     const Linearization& lin, std::array<double, kGroups>* factors = nullptr,
     Redundancy* held = nullptr) {
     const Eigen::Index rows = lin.jacobian.rows();
+    // Each row's group, or -1 for a row that moves with no unknown (it counts in no group).
     std::vector<int> group(static_cast<std::size_t>(rows));
-    for (Eigen::Index r = 0; r < rows; ++r) group[static_cast<std::size_t>(r)] = GroupOf(lin, r);
+    for (Eigen::Index r = 0; r < rows; ++r) {
+        group[static_cast<std::size_t>(r)] = Informative(lin.jacobian, r) ? GroupOf(lin, r) : -1;
+    }
     Eigen::VectorXd scale = Eigen::VectorXd::Ones(rows);
     std::optional<Eigen::MatrixXd> inverse;
     bool settled = false;
@@ -126,7 +129,7 @@ std::optional<Eigen::MatrixXd> VarianceComponentCovariance(
         double squares[kGroups] = {}, redundancy[kGroups] = {};
         for (Eigen::Index r = 0; r < rows; ++r) {
             const int g = group[static_cast<std::size_t>(r)];
-            if (!Informative(lin.jacobian, r)) continue;
+            if (g < 0) continue;
             squares[g] += lin.residuals(r) * lin.residuals(r) / scale(r);
             redundancy[g] += 1.0 - leverage(r);
         }
@@ -142,8 +145,10 @@ std::optional<Eigen::MatrixXd> VarianceComponentCovariance(
                             : std::sqrt(std::max(squares[g] / redundancy[g], kMinVarianceFactor));
             settled = settled && std::abs(factor[g] - 1.0) < kSettledFactor;
         }
-        for (Eigen::Index r = 0; r < rows; ++r)
-            scale(r) *= factor[group[static_cast<std::size_t>(r)]];
+        for (Eigen::Index r = 0; r < rows; ++r) {
+            const int g = group[static_cast<std::size_t>(r)];
+            if (g >= 0) scale(r) *= factor[g];  // a zero row stays zero at any scale
+        }
         if (factors != nullptr) {
             for (int g = 0; g < kGroups; ++g) (*factors)[static_cast<std::size_t>(g)] *= factor[g];
         }
@@ -217,7 +222,8 @@ Eigen::MatrixXd PoseCovariance(const PoseGraph& graph, const PoseGraphConfig& co
     Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(3 * n, 3 * n);
     if (n < 2) return cov;
     const Eigen::Index nodes = 3 * (n - 1);
-    const auto lin = pose_graph_internal::Linearize(graph, config, /*for_covariance=*/true);
+    const auto lin =
+        pose_graph_internal::Linearize(graph, config, pose_graph_internal::Purpose::kCovariance);
     // Without edges (the turntable model alone) nothing is redundant: each pose as well as the
     // prior and the calibration's centre say, at their configured sigmas.
     std::optional<Eigen::MatrixXd> inverse;
