@@ -24,6 +24,10 @@ Status RegistrationCloudConfig::Validate(const std::string& where) const {
         return bad("normal_neighbors", "must be in 3..100");
     }
     if (max_points < 100) return bad("max_points", "must be >= 100");
+    if (min_points < 0 || min_points > max_points) {
+        return bad("min_points", "must be in 0..max_points");
+    }
+    if (min_readings < 1) return bad("min_readings", "must be >= 1");
     if (!(max_surface_variation > 0.0 && max_surface_variation <= 1.0 / 3.0)) {
         return bad("max_surface_variation", "must be in (0, 1/3]");
     }
@@ -81,14 +85,25 @@ struct Regridded {
     double voxel_m = 0.0;
 };
 
-// Returns `base` regridded at the config's voxel, or coarser so that it stays near max_points
-// (surface samples scale with 1 / voxel²).
-Regridded ReduceVoxels(const WeightedVoxels& base, double base_voxel_m,
+// The voxel a view's cloud starts from: the config's, or finer so that a small object's view
+// holds about min_points (surface samples scale with 1 / voxel²: `count` samples at `voxel`,
+// each of `readings` readings on average), down to a voxel of min_readings readings.
+double StartVoxel(const RegistrationCloudConfig& config, double voxel, double count,
+                  double readings) {
+    const double at_config = count * (voxel / config.voxel_m) * (voxel / config.voxel_m);
+    if (at_config <= 0.0 || at_config >= config.min_points) return config.voxel_m;
+    const double wanted = config.voxel_m * std::sqrt(at_config / config.min_points);
+    const double finest = voxel * std::sqrt(config.min_readings / std::max(readings, 1e-9));
+    return std::min(config.voxel_m, std::max(wanted, finest));
+}
+
+// Returns `base` regridded at `voxel_m`, or coarser so that it stays near max_points (surface
+// samples scale with 1 / voxel²).
+Regridded ReduceVoxels(const WeightedVoxels& base, double base_voxel_m, double voxel_m,
                        const RegistrationCloudConfig& config) {
-    double voxel = std::max(config.voxel_m, base_voxel_m);
-    WeightedVoxels v = config.voxel_m > base_voxel_m
-                           ? VoxelGrid(base.centroids, &base.weights, config.voxel_m)
-                           : base;
+    double voxel = std::max(voxel_m, base_voxel_m);
+    WeightedVoxels v =
+        voxel_m > base_voxel_m ? VoxelGrid(base.centroids, &base.weights, voxel_m) : base;
     if (v.centroids.size() > static_cast<std::size_t>(config.max_points)) {
         voxel *= std::sqrt(static_cast<double>(v.centroids.size()) / config.max_points);
         v = VoxelGrid(base.centroids, &base.weights, voxel);
@@ -213,18 +228,25 @@ OrientedPoints Orient(const Regridded& regridded, const RegistrationCloudConfig&
 
 OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config,
                                       const Eigen::Vector3f& viewpoint) {
-    return Orient(ReduceVoxels(VoxelGrid(points, nullptr, config.voxel_m), config.voxel_m, config),
-                  config, viewpoint);
+    return BuildRegistrationClouds(points, config, config, viewpoint).fine;
 }
 
 RegistrationClouds BuildRegistrationClouds(const Points& points,
                                            const RegistrationCloudConfig& coarse,
                                            const RegistrationCloudConfig& fine,
                                            const Eigen::Vector3f& viewpoint) {
-    const double base_voxel = std::min(coarse.voxel_m, fine.voxel_m);
-    const WeightedVoxels base = VoxelGrid(points, nullptr, base_voxel);
-    return {Orient(ReduceVoxels(base, base_voxel, coarse), coarse, viewpoint),
-            Orient(ReduceVoxels(base, base_voxel, fine), fine, viewpoint)};
+    double base_voxel = std::min(coarse.voxel_m, fine.voxel_m);
+    WeightedVoxels base = VoxelGrid(points, nullptr, base_voxel);
+    const auto count = static_cast<double>(base.centroids.size());
+    const double readings = base.centroids.empty() ? 0.0 : points.size() / count;
+    const double coarse_voxel = StartVoxel(coarse, base_voxel, count, readings);
+    const double fine_voxel = StartVoxel(fine, base_voxel, count, readings);
+    if (std::min(coarse_voxel, fine_voxel) < base_voxel) {
+        base_voxel = std::min(coarse_voxel, fine_voxel);
+        base = VoxelGrid(points, nullptr, base_voxel);
+    }
+    return {Orient(ReduceVoxels(base, base_voxel, coarse_voxel, coarse), coarse, viewpoint),
+            Orient(ReduceVoxels(base, base_voxel, fine_voxel, fine), fine, viewpoint)};
 }
 
 }  // namespace boxd

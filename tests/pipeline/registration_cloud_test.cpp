@@ -27,11 +27,13 @@ Points FlatGrid() {
 // A camera above the grids, in front of the wall x = 0.001 of the L below.
 const Eigen::Vector3f kAbove(0.5f, 0.06f, 0.5f);
 
-// A config without outlier removal, so that only the voxel grid decides the count.
+// A config without outlier removal, so that only the voxel grid decides the count, and at its
+// voxel however few points a view holds.
 RegistrationCloudConfig NoOutlierRemoval(double voxel_m) {
     RegistrationCloudConfig c;
     c.voxel_m = voxel_m;
     c.outlier_neighbors = 0;
+    c.min_points = 0;
     return c;
 }
 
@@ -103,6 +105,7 @@ TEST(BuildRegistrationCloud, RemovesIsolatedOutliers) {
     pts.emplace_back(-0.3f, 0.2f, 0.4f);
     pts.emplace_back(0.2f, -0.3f, 0.5f);
     RegistrationCloudConfig config;
+    config.min_points = 0;
     ASSERT_GT(config.outlier_neighbors, 0);
     const OrientedPoints cloud = BuildRegistrationCloud(pts, config, kAbove);
     EXPECT_EQ(cloud.points.size(), 400u);
@@ -141,6 +144,36 @@ TEST(BuildRegistrationCloud, DropsEdgePointsByMaxSurfaceVariation) {
     EXPECT_EQ(far_floor, 17 * 20);
     EXPECT_EQ(far_wall, 17 * 20);
     EXPECT_LT(cloud.points.size(), 780u);
+}
+
+// Centroids of 2 x 2 points of the 2 mm grid lie on even millimetres (4 mm voxels from 0).
+void ExpectFourMillimetreVoxels(const OrientedPoints& cloud) {
+    ASSERT_EQ(cloud.points.size(), 900u);
+    for (const Eigen::Vector3f& p : cloud.points) {
+        for (int a = 0; a < 2; ++a) {
+            const double k = (p[a] - 0.002) / 0.004;
+            EXPECT_NEAR(k, std::round(k), 1e-4) << p.transpose();
+        }
+    }
+}
+
+TEST(BuildRegistrationCloud, MinPointsShrinksTheVoxelOfASmallView) {
+    RegistrationCloudConfig config = NoOutlierRemoval(0.006);
+    config.min_points = 900;
+    config.min_readings = 1;
+    // 400 voxels of 6 mm are 2.25 times too few: the voxel shrinks by 1.5 to 4 mm.
+    ExpectFourMillimetreVoxels(BuildRegistrationCloud(FlatGrid(), config, kAbove));
+}
+
+TEST(BuildRegistrationCloud, MinReadingsBoundsTheShrinking) {
+    RegistrationCloudConfig config = NoOutlierRemoval(0.006);
+    config.min_points = 3600;
+    config.min_readings = 4;
+    // 3600 points would take 2 mm voxels of one reading each; 6 mm voxels hold 9 readings, so
+    // 4 mm ones hold the 4 asked for.
+    ExpectFourMillimetreVoxels(BuildRegistrationCloud(FlatGrid(), config, kAbove));
+    config.min_points = 0;
+    EXPECT_EQ(BuildRegistrationCloud(FlatGrid(), config, kAbove).points.size(), 400u);
 }
 
 TEST(BuildRegistrationCloud, MaxPointsGrowsTheVoxel) {
