@@ -18,46 +18,35 @@ namespace boxd {
 
 namespace {
 
-// Returns the area of the convex hull of the centres of the cells (of `cell` metres) that hold
-// at least `min_points` of `points`.
-double CellHullArea(const std::vector<Eigen::Vector2d>& points, double cell, int min_points) {
-    const auto counts = envelope::CountFootprintCells(points, cell);
+// The convex hull of the footprint over the smallest rectangle round that hull: 1 for a box,
+// pi/4 for a tube standing, 7/8 for an L of a quarter cut away. Noise scatters single readings a
+// few sigma beyond the surface, and a hull of readings would grow by that all round; the hull is
+// therefore taken of the centres of the footprint cells that hold several readings (scattered
+// readings rarely share a cell). The rectangle is the hull's own, not the face fit's: cut into
+// the same cells, the two grow and shrink together with the cells' placing, and a tube's face
+// fit stands at its flanks' mean planes, inside the circle (an 80 mm tube's at 77 mm, whose
+// rectangle the circle's cells then filled to 1). The cells are fill_cell_m, or finer for a small
+// footprint, so that fill_cells_across of them span its width: a box's hull loses about a cell's
+// share of its corners, 2-3% at 16 cells, where a circle's stays near pi/4.
+double FillRatio(const envelope::Surface& surface, const EnclosingCuboid& c,
+                 const EnvelopeConfig& config) {
+    const double cell = std::min(config.fill_cell_m, c.width_m / config.fill_cells_across);
+    if (!(cell > 0.0)) return 0.0;
+    std::vector<Eigen::Vector2d> footprint;
+    footprint.reserve(surface.points.size());
+    for (const Eigen::Vector3f& p : surface.points) footprint.push_back(p.head<2>().cast<double>());
     std::vector<cv::Point2f> centres;
-    for (const auto& [key, n] : counts) {
-        if (n < min_points) continue;
+    for (const auto& [key, n] : envelope::CountFootprintCells(footprint, cell)) {
+        if (n < config.fill_cell_points) continue;
         centres.emplace_back(static_cast<float>((key.first + 0.5) * cell),
                              static_cast<float>((key.second + 0.5) * cell));
     }
     if (centres.size() < 3) return 0.0;
     std::vector<cv::Point2f> hull;
     cv::convexHull(centres, hull);
-    return cv::contourArea(hull);
-}
-
-// The area of the convex hull of the footprint over the rectangle's: 1 for a box, pi/4 for a
-// tube standing, 7/8 for an L of a quarter cut away. Noise scatters single readings a few sigma
-// beyond the surface, and a hull of readings would grow by that all round; the hull is therefore
-// taken of the footprint cells that hold several readings (scattered readings rarely share a
-// cell), and compared with the same hull of the rectangle itself, filled and cut into the same
-// cells, so that the cells' own coarseness cancels.
-double FillRatio(const envelope::Surface& surface, const EnclosingCuboid& c,
-                 const EnvelopeConfig& config) {
-    const double cell = config.fill_cell_m;
-    std::vector<Eigen::Vector2d> footprint;
-    for (const Eigen::Vector3f& p : surface.points) {
-        footprint.push_back(p.head<2>().cast<double>());
-    }
-    const Eigen::Vector2d a = c.length_axis, b(-a.y(), a.x());
-    std::vector<Eigen::Vector2d> rectangle;
-    const double step = cell / 4.0;
-    for (double u = -c.length_m / 2.0 + step / 2.0; u < c.length_m / 2.0; u += step) {
-        for (double v = -c.width_m / 2.0 + step / 2.0; v < c.width_m / 2.0; v += step) {
-            rectangle.push_back(c.center_m + u * a + v * b);
-        }
-    }
-    const double reference = CellHullArea(rectangle, cell, 1);
-    if (reference <= 0.0) return 0.0;
-    return std::min(1.0, CellHullArea(footprint, cell, config.fill_cell_points) / reference);
+    const double rectangle = cv::minAreaRect(hull).size.area();
+    if (!(rectangle > 0.0)) return 0.0;
+    return std::min(1.0, cv::contourArea(hull) / rectangle);
 }
 
 // The share of the footprint's readings (in cells of fill_cell_m holding at least
@@ -110,6 +99,7 @@ Status EnvelopeConfig::Validate() const {
     if (!(layer_sigmas > 0.0)) return bad("layer_sigmas", "must be > 0");
     if (!(min_fill > 0.0 && min_fill <= 1.0)) return bad("min_fill", "in (0, 1]");
     if (!(fill_cell_m > 0.0 && fill_cell_m < 0.05)) return bad("fill_cell_m", "in (0, 0.05)");
+    if (!(fill_cells_across >= 4.0)) return bad("fill_cells_across", "must be >= 4");
     if (fill_cell_points < 1) return bad("fill_cell_points", "must be >= 1");
     if (!(max_relative_excess > 0.0)) return bad("max_relative_excess", "must be > 0");
     if (!(top_band > 0.0 && top_band < 1.0)) return bad("top_band", "in (0, 1)");

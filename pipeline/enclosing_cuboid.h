@@ -59,8 +59,9 @@ struct EnvelopeConfig {
     // a hundredth), and no face stands out of its plane by more than max_relative_excess of the
     // box's size across that face (a full carton's panel bows out by about 1%).
     double min_fill = 0.93;
-    double fill_cell_m = 0.01;  // footprint cells of the fill's hull ...
-    int fill_cell_points = 3;   // ... holding at least this many readings
+    double fill_cell_m = 0.01;        // footprint cells of the fill's hull ...
+    double fill_cells_across = 16.0;  // ... or finer, this many across a small footprint ...
+    int fill_cell_points = 3;         // ... holding at least this many readings
     double max_relative_excess = 0.03;
     // ... and its top is flat over the whole footprint: of the readings of the footprint cells,
     // at least min_top_cover stand in cells that reach within top_band of the height up (a box's

@@ -137,6 +137,30 @@ TEST(FitEnclosingCuboid, StandingTubeIsIrregularAndBoundedByItsDiameter) {
     EXPECT_LT(c.fill, EnvelopeConfig{}.min_fill);
 }
 
+// An 80 mm tube's face fit stands at its flanks' mean planes, inside the circle: against that
+// rectangle, its centimetre cells filled to 1 and it read as a cuboid 3 mm small. Against the
+// hull's own rectangle, in cells a sixteenth of its width, it fills about pi/4.
+TEST(FitEnclosingCuboid, SmallStandingTubeIsIrregular) {
+    const double r = 0.04, h = 0.20;
+    const Fitted f = Fit(SampleCylinder(r, h, {0.01, -0.02}, 3));
+    ASSERT_TRUE(f.cuboid.ok()) << f.cuboid.error().message;
+    EXPECT_FALSE(f.cuboid->cuboid) << "fill " << f.cuboid->fill;
+    EXPECT_LT(f.cuboid->fill, 0.88);
+    EXPECT_NEAR(f.cuboid->length_m, 2 * r, 0.002);
+    EXPECT_NEAR(f.cuboid->width_m, 2 * r, 0.002);
+}
+
+// ... while a box of that size, at any yaw, fills its rectangle in the same cells.
+TEST(FitEnclosingCuboid, SmallBoxFillsItsRectangle) {
+    const double l = 0.08, w = 0.06, h = 0.05;
+    for (const double yaw : {0.0, 0.3, 0.785}) {
+        const Fitted f = Fit(SampleBlocks({{-l / 2, l / 2, -w / 2, w / 2, h}}, 0.0, yaw,
+                                          {0.01, 0.0}, 1));
+        ASSERT_TRUE(f.cuboid.ok()) << f.cuboid.error().message;
+        EXPECT_GT(f.cuboid->fill, EnvelopeConfig{}.min_fill) << "yaw " << yaw;
+    }
+}
+
 TEST(FitEnclosingCuboid, StandingTubesDiameterIsNotTheLeastOfItsNoisyWidths) {
     // Every direction's rectangle around a tube is the same up to the noise: the least of them
     // is the one the noise made smallest. Over seeds the diameter must come out unbiased.
@@ -170,9 +194,10 @@ TEST(FitEnclosingCuboid, LShapeIsIrregularAndBoundedByItsBoundingBox) {
     EXPECT_NEAR(c.height_m, h, kFaceTol);
     EXPECT_NEAR(std::abs(c.length_axis.dot(Eigen::Vector2d(std::cos(0.7), std::sin(0.7)))), 1.0,
                 1e-3);
-    // The hull cuts the missing quarter's diagonal: 7/8 of the rectangle, plus the noise's
-    // widening of the hull (perimeter 1.3 m x ~5 mm / 0.12 m^2 = +0.05 at most).
-    EXPECT_GT(c.fill, 0.87);
+    // The hull cuts the missing quarter's diagonal: 7/8 of the rectangle, less about a cell's
+    // share of the corners (2-3%), plus the noise's widening of the hull (perimeter 1.3 m x ~5
+    // mm / 0.12 m^2 = +0.05 at most).
+    EXPECT_GT(c.fill, 0.84);
     EXPECT_LT(c.fill, EnvelopeConfig{}.min_fill);
 }
 
@@ -426,6 +451,7 @@ TEST(EnvelopeConfig, ValidateNamesTheField) {
         {"false_alarm", [](EnvelopeConfig& c) { c.false_alarm = 0.5; }},
         {"directions", [](EnvelopeConfig& c) { c.directions = 17; }},
         {"min_fill", [](EnvelopeConfig& c) { c.min_fill = 1.1; }},
+        {"fill_cells_across", [](EnvelopeConfig& c) { c.fill_cells_across = 2.0; }},
         {"max_view_spread_rmse", [](EnvelopeConfig& c) { c.max_view_spread_rmse = std::nan(""); }},
         {"max_incidence_deg", [](EnvelopeConfig& c) { c.max_incidence_deg = 90.0; }},
         {"threads", [](EnvelopeConfig& c) { c.threads = 0; }},
