@@ -15,6 +15,17 @@ namespace boxd::envelope {
 
 namespace {
 
+// The views (each a sample of its mean) a cell needs to be judged. A cell standing out on its
+// own (a strap, a label: ReadExcess, ReadPatches) takes four: three views that agree on an
+// ideal box's cells by a vertical edge, where one of them sees the face at grazing, can put
+// two such cells 0.67 mm out of the plane (a 353 x 349 mm box, 12 poses of 6 frames). The
+// whole face bowing out (BowedFaceReach) takes three: a smooth bow over the face is not two
+// cells by its edge, and with four a face only three views see (12 poses, a camera 39 degrees
+// up) kept its edges and lost its middle, so a side bulging 4.9 mm read at its mean plane,
+// 2.5 mm in.
+constexpr int kCellViews = 4;
+constexpr int kBowCellViews = 3;
+
 // A face is judged flat or not from at least this many cells seen by two views or more.
 constexpr int kMinFlatnessCells = 10;
 
@@ -86,7 +97,10 @@ struct FaceCells {
             samples > 0 ? std::max(0.0, spread * spread - noise * inverse_sum / samples) : 0.0;
         std::vector<Judged> judged;
         for (const auto& [cell, st] : cells) {
-            if (st.n * 3 < config.min_cell_points && dof >= 10) continue;
+            // A cell is judged from three views on (its own scatter then has two degrees of
+            // freedom to check the modelled error against); see kCellViews for which reading
+            // takes which.
+            if (st.n < kBowCellViews && dof >= 10) continue;
             // A cell whose views scatter more than the face's do (an edge some views see at
             // grazing incidence, where the lateral noise throws readings off the face) is
             // known no better than its own scatter says.
@@ -126,7 +140,11 @@ struct FaceCells {
         out.offset_se_m =
             offsets.n >= 2 ? WidenedForSamples(std::sqrt(offsets.Variance() / offsets.n), offsets.n)
                            : spread / std::sqrt(std::max<std::size_t>(1, cells.size()));
-        ReadExcess(judged, config, out.view_spread_m, &out);
+        std::vector<Judged> many;  // the cells seen by kCellViews views or more
+        for (const Judged& c : judged) {
+            if (c.st.n >= kCellViews || dof < 10) many.push_back(c);
+        }
+        ReadExcess(many, config, out.view_spread_m, &out);
         // A panel bowing out smoothly shows as a whole face (bowed_face.h).
         std::vector<FaceCell> face;
         face.reserve(judged.size());
@@ -140,7 +158,7 @@ struct FaceCells {
             out.excess_m = bow->excess_m;
             out.excess_se_m = bow->se_m;
         }
-        if (dof >= 10) ReadPatches(judged, shared, config, &out);
+        if (dof >= 10) ReadPatches(many, shared, config, &out);
         return out;
     }
 

@@ -146,15 +146,21 @@ TEST(BuildRegistrationCloud, DropsEdgePointsByMaxSurfaceVariation) {
     EXPECT_LT(cloud.points.size(), 780u);
 }
 
-// Centroids of 2 x 2 points of the 2 mm grid lie on even millimetres (4 mm voxels from 0).
-void ExpectFourMillimetreVoxels(const OrientedPoints& cloud) {
-    ASSERT_EQ(cloud.points.size(), 900u);
+// Expects `count` centroids, each the centre of a voxel of `voxel` metres (voxels from 0) in x
+// and y: the centroid of the grid's points in a voxel that holds whole rows and columns of them.
+void ExpectVoxelCentres(const OrientedPoints& cloud, std::size_t count, double voxel) {
+    ASSERT_EQ(cloud.points.size(), count);
     for (const Eigen::Vector3f& p : cloud.points) {
         for (int a = 0; a < 2; ++a) {
-            const double k = (p[a] - 0.002) / 0.004;
+            const double k = (p[a] - voxel / 2) / voxel;
             EXPECT_NEAR(k, std::round(k), 1e-4) << p.transpose();
         }
     }
+}
+
+// Centroids of 2 x 2 points of the 2 mm grid lie on even millimetres (4 mm voxels from 0).
+void ExpectFourMillimetreVoxels(const OrientedPoints& cloud) {
+    ExpectVoxelCentres(cloud, 900u, 0.004);
 }
 
 TEST(BuildRegistrationCloud, MinPointsShrinksTheVoxelOfASmallView) {
@@ -181,14 +187,7 @@ TEST(BuildRegistrationCloud, MaxPointsGrowsTheVoxel) {
     config.max_points = 100;
     // 400 voxels of 6 mm are 4 times too many: the voxel grows by sqrt(4) to 12 mm, which
     // holds 2 x 2 of the 6 mm voxels, 10 x 10 voxels of 12 mm.
-    const OrientedPoints cloud = BuildRegistrationCloud(FlatGrid(), config, kAbove);
-    ASSERT_EQ(cloud.points.size(), 100u);
-    for (const Eigen::Vector3f& p : cloud.points) {
-        for (int a = 0; a < 2; ++a) {
-            const double k = (p[a] - 0.006) / 0.012;
-            EXPECT_NEAR(k, std::round(k), 1e-4) << p.transpose();
-        }
-    }
+    ExpectVoxelCentres(BuildRegistrationCloud(FlatGrid(), config, kAbove), 100u, 0.012);
 }
 
 TEST(BuildRegistrationClouds, NestedVoxelsMatchDirectPasses) {
