@@ -154,8 +154,8 @@ TEST(FitEnclosingCuboid, SmallStandingTubeIsIrregular) {
 TEST(FitEnclosingCuboid, SmallBoxFillsItsRectangle) {
     const double l = 0.08, w = 0.06, h = 0.05;
     for (const double yaw : {0.0, 0.3, 0.785}) {
-        const Fitted f = Fit(SampleBlocks({{-l / 2, l / 2, -w / 2, w / 2, h}}, 0.0, yaw,
-                                          {0.01, 0.0}, 1));
+        const Fitted f =
+            Fit(SampleBlocks({{-l / 2, l / 2, -w / 2, w / 2, h}}, 0.0, yaw, {0.01, 0.0}, 1));
         ASSERT_TRUE(f.cuboid.ok()) << f.cuboid.error().message;
         EXPECT_GT(f.cuboid->fill, EnvelopeConfig{}.min_fill) << "yaw " << yaw;
     }
