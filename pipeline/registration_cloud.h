@@ -18,9 +18,10 @@ struct RegistrationCloudConfig {
     // Points whose neighbourhood is not planar (surface variation λ0 / Σλ above this, Pauly et
     // al. 2002) sit on edges and corners: their normals are blends that pull ICP sideways.
     double max_surface_variation = 0.02;
-    // Small objects get a proportionally smaller voxel so that a view holds at least this many
-    // points: at 6 mm an 8 cm carton's sides hold a few rows of voxels, most of them at edges
-    // whose normals are dropped, and too few upright pairs are left to align two views on ...
+    // Small objects get a proportionally smaller voxel so that a view holds about this many
+    // points before outlier removal and the edges' normals thin it: at 6 mm an 8 cm carton's
+    // sides hold a few rows of voxels, most of them at edges whose normals are dropped, and too
+    // few upright pairs are left to align two views on ...
     int min_points = 1000;
     // ... but no smaller than a voxel that averages this many readings on the view's surface
     // (a 2 x 2 patch of pixels: a voxel of single readings has its normal from the noise).

@@ -15,7 +15,7 @@ namespace boxd {
 
 struct RegistrationConfig {
     // The coarse cloud's voxel is twice the fine one's, and its min_points a quarter: both
-    // shrink from the same object size on.
+    // start shrinking at the same object size (each stops at its own min_readings voxel).
     RegistrationCloudConfig coarse_cloud{0.012, 8, 2.0, 10, 1000, 0.03, 250};
     RegistrationCloudConfig fine_cloud{0.006, 8, 2.0, 10, 3000, 0.02, 1000};
     // Coarse: wide gate on the sparse cloud; fine: narrow gate on the denser one.
