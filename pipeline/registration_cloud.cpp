@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <initializer_list>
+#include <vector>
 
 #include "pipeline/key_index.h"
 #include "pipeline/nearest_grid.h"
@@ -167,7 +169,9 @@ struct LocalPlane {
 LocalPlane FitLocalPlane(const Points& points, const std::vector<Neighbour>& near) {
     const auto count = static_cast<double>(near.size());
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (const Neighbour& n : near) mean += points[static_cast<std::size_t>(n.index)].cast<double>();
+    for (const Neighbour& n : near) {
+        mean += points[static_cast<std::size_t>(n.index)].cast<double>();
+    }
     mean /= count;
     Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
     for (const Neighbour& n : near) {
@@ -224,29 +228,53 @@ OrientedPoints Orient(const Regridded& regridded, const RegistrationCloudConfig&
     return out;
 }
 
+// One voxel pass of a view's points for clouds of `configs`: at the finest voxel any of them
+// starts from (StartVoxel), each config's start voxel in `voxels`.
+struct BasePass {
+    WeightedVoxels voxels;
+    double voxel_m = 0.0;
+};
+
+BasePass VoxelBase(const Points& points,
+                   std::initializer_list<const RegistrationCloudConfig*> configs,
+                   std::vector<double>* voxels) {
+    BasePass base;
+    base.voxel_m = (*configs.begin())->voxel_m;
+    for (const RegistrationCloudConfig* c : configs) {
+        base.voxel_m = std::min(base.voxel_m, c->voxel_m);
+    }
+    base.voxels = VoxelGrid(points, nullptr, base.voxel_m);
+    const auto count = static_cast<double>(base.voxels.centroids.size());
+    const double readings = base.voxels.centroids.empty() ? 0.0 : points.size() / count;
+    double finest = base.voxel_m;
+    for (const RegistrationCloudConfig* c : configs) {
+        voxels->push_back(StartVoxel(*c, base.voxel_m, count, readings));
+        finest = std::min(finest, voxels->back());
+    }
+    if (finest < base.voxel_m) {
+        base.voxel_m = finest;
+        base.voxels = VoxelGrid(points, nullptr, finest);
+    }
+    return base;
+}
+
 }  // namespace
 
 OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config,
                                       const Eigen::Vector3f& viewpoint) {
-    return BuildRegistrationClouds(points, config, config, viewpoint).fine;
+    std::vector<double> voxels;
+    const BasePass base = VoxelBase(points, {&config}, &voxels);
+    return Orient(ReduceVoxels(base.voxels, base.voxel_m, voxels[0], config), config, viewpoint);
 }
 
 RegistrationClouds BuildRegistrationClouds(const Points& points,
                                            const RegistrationCloudConfig& coarse,
                                            const RegistrationCloudConfig& fine,
                                            const Eigen::Vector3f& viewpoint) {
-    double base_voxel = std::min(coarse.voxel_m, fine.voxel_m);
-    WeightedVoxels base = VoxelGrid(points, nullptr, base_voxel);
-    const auto count = static_cast<double>(base.centroids.size());
-    const double readings = base.centroids.empty() ? 0.0 : points.size() / count;
-    const double coarse_voxel = StartVoxel(coarse, base_voxel, count, readings);
-    const double fine_voxel = StartVoxel(fine, base_voxel, count, readings);
-    if (std::min(coarse_voxel, fine_voxel) < base_voxel) {
-        base_voxel = std::min(coarse_voxel, fine_voxel);
-        base = VoxelGrid(points, nullptr, base_voxel);
-    }
-    return {Orient(ReduceVoxels(base, base_voxel, coarse_voxel, coarse), coarse, viewpoint),
-            Orient(ReduceVoxels(base, base_voxel, fine_voxel, fine), fine, viewpoint)};
+    std::vector<double> voxels;
+    const BasePass base = VoxelBase(points, {&coarse, &fine}, &voxels);
+    return {Orient(ReduceVoxels(base.voxels, base.voxel_m, voxels[0], coarse), coarse, viewpoint),
+            Orient(ReduceVoxels(base.voxels, base.voxel_m, voxels[1], fine), fine, viewpoint)};
 }
 
 }  // namespace boxd
