@@ -228,16 +228,16 @@ OrientedPoints Orient(const Regridded& regridded, const RegistrationCloudConfig&
     return out;
 }
 
-// One voxel pass of a view's points for clouds of `configs`: at the finest voxel any of them
-// starts from (StartVoxel), each config's start voxel in `voxels`.
+// One voxel pass of a view's points for clouds of `configs`, at the finest voxel any of them
+// starts from (StartVoxel); `start` holds each config's start voxel, in their order.
 struct BasePass {
     WeightedVoxels voxels;
     double voxel_m = 0.0;
+    std::vector<double> start;
 };
 
 BasePass VoxelBase(const Points& points,
-                   std::initializer_list<const RegistrationCloudConfig*> configs,
-                   std::vector<double>* voxels) {
+                   std::initializer_list<const RegistrationCloudConfig*> configs) {
     BasePass base;
     base.voxel_m = (*configs.begin())->voxel_m;
     for (const RegistrationCloudConfig* c : configs) {
@@ -246,11 +246,10 @@ BasePass VoxelBase(const Points& points,
     base.voxels = VoxelGrid(points, nullptr, base.voxel_m);
     const auto count = static_cast<double>(base.voxels.centroids.size());
     const double readings = base.voxels.centroids.empty() ? 0.0 : points.size() / count;
-    double finest = base.voxel_m;
     for (const RegistrationCloudConfig* c : configs) {
-        voxels->push_back(StartVoxel(*c, base.voxel_m, count, readings));
-        finest = std::min(finest, voxels->back());
+        base.start.push_back(StartVoxel(*c, base.voxel_m, count, readings));
     }
+    const double finest = *std::min_element(base.start.begin(), base.start.end());
     if (finest < base.voxel_m) {
         base.voxel_m = finest;
         base.voxels = VoxelGrid(points, nullptr, finest);
@@ -258,23 +257,26 @@ BasePass VoxelBase(const Points& points,
     return base;
 }
 
+// The cloud of `config`, the k-th of the configs `base` was passed for.
+OrientedPoints CloudOf(const BasePass& base, std::size_t k, const RegistrationCloudConfig& config,
+                       const Eigen::Vector3f& viewpoint) {
+    return Orient(ReduceVoxels(base.voxels, base.voxel_m, base.start[k], config), config,
+                  viewpoint);
+}
+
 }  // namespace
 
 OrientedPoints BuildRegistrationCloud(const Points& points, const RegistrationCloudConfig& config,
                                       const Eigen::Vector3f& viewpoint) {
-    std::vector<double> voxels;
-    const BasePass base = VoxelBase(points, {&config}, &voxels);
-    return Orient(ReduceVoxels(base.voxels, base.voxel_m, voxels[0], config), config, viewpoint);
+    return CloudOf(VoxelBase(points, {&config}), 0, config, viewpoint);
 }
 
 RegistrationClouds BuildRegistrationClouds(const Points& points,
                                            const RegistrationCloudConfig& coarse,
                                            const RegistrationCloudConfig& fine,
                                            const Eigen::Vector3f& viewpoint) {
-    std::vector<double> voxels;
-    const BasePass base = VoxelBase(points, {&coarse, &fine}, &voxels);
-    return {Orient(ReduceVoxels(base.voxels, base.voxel_m, voxels[0], coarse), coarse, viewpoint),
-            Orient(ReduceVoxels(base.voxels, base.voxel_m, voxels[1], fine), fine, viewpoint)};
+    const BasePass base = VoxelBase(points, {&coarse, &fine});
+    return {CloudOf(base, 0, coarse, viewpoint), CloudOf(base, 1, fine, viewpoint)};
 }
 
 }  // namespace boxd
