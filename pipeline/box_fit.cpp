@@ -108,12 +108,13 @@ struct FacePoint {
 // then solves the linearised least squares for a common yaw and the four offsets, trimming
 // outliers once. Returns false when a face has too few points.
 bool FitSides(const Points& points, const BoxFitConfig& config, const ReadingRays* rays,
-              const std::array<double, 4>& band, BoxState& s, std::array<int, 5>& counts) {
+              double margin, const std::array<double, 4>& band, BoxState& s,
+              std::array<int, 5>& counts) {
     std::array<Eigen::Vector2d, 4> n;
     for (int f = 0; f < 4; ++f) n[static_cast<std::size_t>(f)] = FaceNormal(s.yaw, f);
     const double half_u = 0.5 * (s.d[0] + s.d[1]), half_v = 0.5 * (s.d[2] + s.d[3]);
     const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);
-    const FaceChoice choice(rays, config.edge_margin_m);
+    const FaceChoice choice(rays, margin);
     const double m = choice.margin(), gate = choice.gate();
     const std::vector<FacePoint> sel = ParallelCollect<FacePoint>(
         points.size(), config.threads,
@@ -200,16 +201,16 @@ bool FitSides(const Points& points, const BoxFitConfig& config, const ReadingRay
 
 // Top face: trimmed mean height of the points inside the footprint (away from its edges) and in
 // the band around the current height estimate.
-bool FitTop(const Points& points, const BoxFitConfig& config, const ReadingRays* rays, double band,
-            BoxState& s, std::array<int, 5>& counts) {
+bool FitTop(const Points& points, const BoxFitConfig& config, const ReadingRays* rays,
+            double margin, double band, BoxState& s, std::array<int, 5>& counts) {
     const Eigen::Vector2d nu = FaceNormal(s.yaw, 0), nv = FaceNormal(s.yaw, 2);
     const double half_u = 0.5 * (s.d[0] + s.d[1]), half_v = 0.5 * (s.d[2] + s.d[3]);
     const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);
-    const FaceChoice choice(rays, config.edge_margin_m);
+    const FaceChoice choice(rays, margin);
     const double m = choice.margin(), gate = choice.gate();
-    auto inside = [&](const Eigen::Vector2d& p, double margin) {
-        return std::abs(nu.dot(p) - cu) <= half_u - margin &&
-               std::abs(nv.dot(p) - cv) <= half_v - margin;
+    auto inside = [&](const Eigen::Vector2d& p, double inset) {
+        return std::abs(nu.dot(p) - cu) <= half_u - inset &&
+               std::abs(nv.dot(p) - cv) <= half_v - inset;
     };
     const std::vector<double> z = ParallelCollect<double>(
         points.size(), config.threads,
@@ -290,8 +291,8 @@ Result<BoxFit> FitFootprintBox(const Points& seed_points, const Points& points,
         s.height = z[static_cast<std::size_t>(q)];
     }
     const double min_side = std::min(s.d[0] + s.d[1], s.d[2] + s.d[3]);
-    if (min_side < 2.0 * config.edge_margin_m + 0.01 ||
-        s.height < 2.0 * config.edge_margin_m + 0.005) {
+    const double margin = EdgeMargin(config.edge_margin_m, std::min(min_side, s.height));
+    if (min_side < 2.0 * margin + 0.01 || s.height < 2.0 * margin + 0.005) {
         return Error{ErrorCode::kObjectTooSmall, "the object is too small to measure"};
     }
     std::array<double, 4> band;
@@ -303,10 +304,10 @@ Result<BoxFit> FitFootprintBox(const Points& seed_points, const Points& points,
     // and the height is left to the enclosing cuboid (where the side faces end).
     bool top_observed = true;
     for (int it = 0; it < config.iterations; ++it) {
-        if (top_observed && !FitTop(points, config, by_ray, top_band, s, counts)) {
+        if (top_observed && !FitTop(points, config, by_ray, margin, top_band, s, counts)) {
             top_observed = false;
         }
-        if (!FitSides(points, config, by_ray, band, s, counts)) {
+        if (!FitSides(points, config, by_ray, margin, band, s, counts)) {
             return Error{ErrorCode::kInsufficientData,
                          "a side face of the object is not observed well enough"};
         }
@@ -317,7 +318,7 @@ Result<BoxFit> FitFootprintBox(const Points& seed_points, const Points& points,
         top_band =
             std::clamp(config.band_sigmas * s.sigma[4], config.min_band_m, config.initial_band_m);
     }
-    if (top_observed && !FitTop(points, config, by_ray, top_band, s, counts)) {
+    if (top_observed && !FitTop(points, config, by_ray, margin, top_band, s, counts)) {
         top_observed = false;
     }
     BoxFit fit;

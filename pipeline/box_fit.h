@@ -22,8 +22,10 @@ struct BoxFitConfig {
     double initial_band_m = 0.02;       // half-width of the band around a face in the first pass
     double min_band_m = 0.006;          // the band shrinks to max(band_sigmas * sigma, this)
     double band_sigmas = 4.0;
-    double edge_margin_m = 0.015;  // face points this close to an edge or corner are excluded
-    double trim_sigmas = 2.5;      // face points beyond this many robust sigmas are outliers
+    // Face points this close to an edge or corner are excluded (at most a quarter of the
+    // object's smallest extent: EdgeMargin).
+    double edge_margin_m = 0.015;
+    double trim_sigmas = 2.5;  // face points beyond this many robust sigmas are outliers
     int iterations = 5;
     int min_face_points = 40;
     int threads = 2;  // for the passes over the cloud

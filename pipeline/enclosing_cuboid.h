@@ -35,11 +35,13 @@
 namespace boxd {
 
 struct EnvelopeConfig {
-    double cell_along_m = 0.012;      // cell size along a face (and across the top)
-    double cell_height_m = 0.012;     // cell size up a side face
-    int min_cell_points = 12;         // smaller cells are not judged (support function)
-    double false_alarm = 0.05;        // chance that noise alone moves a flat face outwards
-    double edge_margin_m = 0.015;     // points this close to a face's edges belong to no cell of it
+    double cell_along_m = 0.012;   // cell size along a face (and across the top)
+    double cell_height_m = 0.012;  // cell size up a side face
+    int min_cell_points = 12;      // smaller cells are not judged (support function)
+    double false_alarm = 0.05;     // chance that noise alone moves a flat face outwards
+    // Points this close to a face's edges belong to no cell of it (at most a quarter of the
+    // object's smallest extent: EdgeMargin).
+    double edge_margin_m = 0.015;
     double inward_band_sigmas = 3.0;  // a face's points lie from this far inside its plane ...
     double outward_band_m = 0.06;     // ... to this far outside it
     int directions = 180;             // footprint orientations over 180 degrees (irregular)

@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "pipeline/enclosing_cuboid.h"
+#include "pipeline/face_choice.h"
 #include "pipeline/fuse_and_fit.h"
 #include "pipeline/object_views.h"
 #include "pipeline/refusal.h"
@@ -145,7 +146,8 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
             std::hypot(SharedRoundingSigma(
                            TopRounding(fit.fused, registered->poses, *cuboid, table.camera_to_table,
                                        session.calibration, config.box_fit.min_band_m,
-                                       config.envelope.edge_margin_m),
+                                       EdgeMargin(config.envelope.edge_margin_m,
+                                                  std::min(cuboid->width_m, cuboid->height_m))),
                            unit),
                        SharedRoundingSigma(table.rounding, unit));
         spdlog::debug("uncertainty: the depths' rounding {:.3f} mm in the height", rounding * 1e3);

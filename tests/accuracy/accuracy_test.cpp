@@ -202,7 +202,7 @@ TEST(Accuracy, SyntheticSuiteWithinTolerance) {
     std::printf("\n%-24s %-10s %-9s %-9s %8s %8s %8s %6s %24s %8s\n", "case", "group", "status",
                 "shape", "dL mm", "dW mm", "dH mm", "tol mm", "95% bound L/W/H mm", "proc ms");
     for (const Outcome& o : outcomes) {
-        std::printf("%-24s %-10s %-9s %-9s %8.2f %8.2f %8.2f %6.1f %8.2f %7.2f %7.2f %8.0f %s\n",
+        std::printf("%-24s %-10s %-9s %-9s %8.3f %8.3f %8.3f %6.1f %8.3f %7.3f %7.3f %8.0f %s\n",
                     o.name.c_str(), o.group.c_str(), o.status.c_str(), o.shape.c_str(),
                     o.err[0] * 1000, o.err[1] * 1000, o.err[2] * 1000, o.tol * 1000,
                     o.uncertainty[0] * 1000, o.uncertainty[1] * 1000, o.uncertainty[2] * 1000,

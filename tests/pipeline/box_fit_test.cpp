@@ -73,6 +73,19 @@ TEST(FitFootprintBox, NearSquareFootprint) {
     EXPECT_NEAR(fit->height_m, 0.20, 0.001);
 }
 
+TEST(FitFootprintBox, FitsAFlatSmallCartonWithinItsOwnMargins) {
+    // 30 mm high: the configured 15 mm margin at each end would leave its sides nothing to
+    // read; the margin shrinks to a quarter of the smallest extent (face_choice.h).
+    const Points pts = SampleBox(0.12, 0.08, 0.03, 0.4, {0.01, 0.02}, 0.001, 6, 0.002);
+    auto fit = FitFootprintBox(pts, BoxFitConfig{});
+    ASSERT_TRUE(fit.ok()) << fit.error().message;
+    EXPECT_NEAR(fit->length_m, 0.12, 0.001);
+    EXPECT_NEAR(fit->width_m, 0.08, 0.001);
+    EXPECT_NEAR(fit->height_m, 0.03, 0.001);
+    EXPECT_DOUBLE_EQ(EdgeMargin(0.015, 0.03), 0.0075);
+    EXPECT_DOUBLE_EQ(EdgeMargin(0.015, 0.30), 0.015);
+}
+
 TEST(FitFootprintBox, RefusesTinyObject) {
     const Points pts = SampleBox(0.02, 0.02, 0.02, 0.0, {0.0, 0.0}, 0.0, 4, 0.002);
     auto fit = FitFootprintBox(pts, BoxFitConfig{});
