@@ -17,10 +17,16 @@ edges (5-20 mm), a tube standing or lying, a bag, an L-shaped pack, or a carton 
 open 20-90 degrees; 12-24 poses of 2-4 frames, Kinect or RealSense noise; and the summary adds
 each kind's worst error and how many of its dimensions lie within their bounds.
 
-Usage: scripts/accuracy_sweep.py [--boxd build/daemon/boxd] [--objects boxes|parcels] [--seed 1]
-                                 [--count 60] [--jobs 2]
+With --objects small it draws small and flat cartons: 60-300 mm long, 32-80 mm high (above
+the 30 mm `refusal.min_dimension_m`), on stations drawn as for the parcels (the camera 0.8-1.05 m
+away), 12-24 poses of 2-5 frames; the summary says which are flat (at most half as high as
+wide).
+
+Usage: scripts/accuracy_sweep.py [--boxd build/daemon/boxd] [--objects boxes|parcels|small]
+                                 [--seed 1] [--count 60] [--jobs 2]
 Exit status 1 when a measured object is off by more than --fail-above-mm (default 1.0 for
-boxes, 3.0 for parcels) in any dimension, or no case could be measured.
+boxes, 3.0 for parcels, 2.0 for small cartons) in any dimension, or no case could be
+measured.
 """
 import argparse
 import concurrent.futures
@@ -105,6 +111,27 @@ def draw_parcel(rng, index, seed):
     }
 
 
+def draw_small(rng, index, seed):
+    """One small or flat carton, on a station drawn as for the parcels but nearer."""
+    length = rng.uniform(0.06, 0.3)
+    width = rng.uniform(max(0.05, 0.4 * length), length)
+    height = rng.uniform(0.032, 0.08)
+    return {
+        "name": f"m{seed}_{index}",
+        "kind": "flat" if height <= 0.5 * width else "small",
+        "args": ["--dims", f"{length:.3f}", f"{width:.3f}", f"{height:.3f}",
+                 "--noise", rng.choice(["kinect", "realsense"]),
+                 "--poses", str(rng.choice([12, 18, 24])),
+                 "--frames", str(rng.choice([2, 3, 4, 5])),
+                 "--seed", str(1000 * seed + index),
+                 "--distance", f"{rng.uniform(0.8, 1.05):.2f}",
+                 "--elevation", f"{rng.uniform(30, 50):.0f}",
+                 "--aim-height", f"{height * rng.uniform(0.3, 0.6):.3f}",
+                 "--offset", f"{rng.uniform(-0.03, 0.03):.3f}", f"{rng.uniform(-0.03, 0.03):.3f}",
+                 "--yaw", f"{rng.uniform(0, 90):.0f}"],
+    }
+
+
 def run_case(boxd, case):
     with tempfile.TemporaryDirectory() as tmp:
         session = os.path.join(tmp, "session")
@@ -137,13 +164,13 @@ def main():
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--count", type=int, default=60)
     parser.add_argument("--jobs", type=int, default=2)
-    parser.add_argument("--objects", choices=("boxes", "parcels"), default="boxes")
+    parser.add_argument("--objects", choices=("boxes", "parcels", "small"), default="boxes")
     parser.add_argument("--fail-above-mm", type=float)
     args = parser.parse_args()
     if args.fail_above_mm is None:
-        args.fail_above_mm = 1.0 if args.objects == "boxes" else 3.0
+        args.fail_above_mm = {"boxes": 1.0, "parcels": 3.0, "small": 2.0}[args.objects]
     rng = random.Random(args.seed)
-    draw = draw_case if args.objects == "boxes" else draw_parcel
+    draw = {"boxes": draw_case, "parcels": draw_parcel, "small": draw_small}[args.objects]
     cases = [draw(rng, i, args.seed) for i in range(args.count)]
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         outcomes = list(pool.map(lambda c: run_case(args.boxd, c), cases))

@@ -56,6 +56,9 @@ FusedCloud Top(unsigned seed, double step, double sparse_step, double bump = 0.0
             }
         }
     }
+    // The face envelopes read every reading, before the fusion's support test.
+    cloud.unfiltered = cloud.points;
+    cloud.unfiltered_view = cloud.view;
     return cloud;
 }
 

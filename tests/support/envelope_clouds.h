@@ -27,7 +27,7 @@
 namespace boxd::test {
 
 constexpr int kViews = 8;
-constexpr double kSigma = 0.0015;      // sensor noise per point
+constexpr double kSigma = 0.0015;  // sensor noise per point
 // The camera for FitEnclosingCuboid: straight above the table, where a reading's height carries
 // all of the noise (HeightNoiseSigma), as on these clouds' faces that face up.
 inline const Eigen::Vector3d kOverhead(0.0, 0.0, 3.0);
@@ -79,6 +79,9 @@ private:
                                     center_.y() + s * q.x() + c * q.y(), q.z());
         cloud_.points.push_back((table + shifts_[static_cast<std::size_t>(k)]).cast<float>());
         cloud_.view.push_back(static_cast<std::uint16_t>(k));
+        // Every reading passes the fusion's support test here: the cloud before it is the same.
+        cloud_.unfiltered.push_back(cloud_.points.back());
+        cloud_.unfiltered_view.push_back(cloud_.view.back());
     }
 
     double yaw_;
