@@ -122,11 +122,16 @@ PairAlignment AlignViewPair(int i, int j, const ViewClouds& view_j, const ViewTa
     out.fine = AlignIcp(view_j.fine, target_i.fine, coarse.transform, config.fine);
     out.coarse_iterations = coarse.iterations;
     // Too few upright pairs on the fine cloud to move it (a small object in one noisy frame:
-    // its 6 mm cells' normals scatter past the pairing's agreement): the coarse alignment, on
-    // cells twice as large, is the measurement, and the edge carries its weaker information.
+    // its 6 mm cells' normals scatter past the pairing's agreement): the coarse cloud, on cells
+    // twice as large, is the measurement, and the edge carries its weaker information. Its
+    // alignment is carried on by the planes alone, as the fine stage's is: the coarse stage's
+    // point-to-point pull holds what the planes fix only weakly where it started, at the
+    // turntable model, whose centre is the calibration's (view_registration.h).
     if (out.fine.solved < config.fine.min_correspondences &&
         coarse.solved >= config.coarse.min_correspondences) {
-        out.fine = coarse;
+        IcpConfig planes = config.coarse;
+        planes.point_to_point_weight = 0.0;
+        out.fine = AlignIcp(view_j.coarse, target_i.coarse, coarse.transform, planes);
     }
     PoseEdge& edge = out.edge;
     edge.from = i;
