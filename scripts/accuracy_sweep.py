@@ -69,6 +69,23 @@ def draw_case(rng, index, seed):
     }
 
 
+def parcel_station(rng, dims, render_seed, frames, distance):
+    """`boxd synth` options for an object of `dims` on a station drawn for the parcel sweeps:
+    either noise model, 12-24 poses of a count of `frames`, the camera `distance` (a range)
+    away and 30-50 degrees up, the object up to 3 cm off the axis at any yaw."""
+    length, width, height = dims
+    return ["--dims", f"{length:.3f}", f"{width:.3f}", f"{height:.3f}",
+            "--noise", rng.choice(["kinect", "realsense"]),
+            "--poses", str(rng.choice([12, 18, 24])),
+            "--frames", str(rng.choice(frames)),
+            "--seed", str(render_seed),
+            "--distance", f"{rng.uniform(*distance):.2f}",
+            "--elevation", f"{rng.uniform(30, 50):.0f}",
+            "--aim-height", f"{height * rng.uniform(0.3, 0.6):.3f}",
+            "--offset", f"{rng.uniform(-0.03, 0.03):.3f}", f"{rng.uniform(-0.03, 0.03):.3f}",
+            "--yaw", f"{rng.uniform(0, 90):.0f}"]
+
+
 PARCEL_KINDS = ("bulge", "strap", "label", "rounded", "tube", "lying tube", "bag", "l_shape",
                 "flap")
 
@@ -98,16 +115,8 @@ def draw_parcel(rng, index, seed):
     return {
         "name": f"p{seed}_{index}",
         "kind": kind,
-        "args": ["--dims", f"{length:.3f}", f"{width:.3f}", f"{height:.3f}",
-                 "--noise", rng.choice(["kinect", "realsense"]),
-                 "--poses", str(rng.choice([12, 18, 24])),
-                 "--frames", str(rng.choice([2, 3, 4])),
-                 "--seed", str(1000 * seed + index),
-                 "--distance", f"{rng.uniform(0.85, 1.15):.2f}",
-                 "--elevation", f"{rng.uniform(30, 50):.0f}",
-                 "--aim-height", f"{height * rng.uniform(0.3, 0.6):.3f}",
-                 "--offset", f"{rng.uniform(-0.03, 0.03):.3f}", f"{rng.uniform(-0.03, 0.03):.3f}",
-                 "--yaw", f"{rng.uniform(0, 90):.0f}", *features],
+        "args": [*parcel_station(rng, (length, width, height), 1000 * seed + index, [2, 3, 4],
+                                 (0.85, 1.15)), *features],
     }
 
 
@@ -119,16 +128,8 @@ def draw_small(rng, index, seed):
     return {
         "name": f"m{seed}_{index}",
         "kind": "flat" if height <= 0.5 * width else "small",
-        "args": ["--dims", f"{length:.3f}", f"{width:.3f}", f"{height:.3f}",
-                 "--noise", rng.choice(["kinect", "realsense"]),
-                 "--poses", str(rng.choice([12, 18, 24])),
-                 "--frames", str(rng.choice([2, 3, 4, 5])),
-                 "--seed", str(1000 * seed + index),
-                 "--distance", f"{rng.uniform(0.8, 1.05):.2f}",
-                 "--elevation", f"{rng.uniform(30, 50):.0f}",
-                 "--aim-height", f"{height * rng.uniform(0.3, 0.6):.3f}",
-                 "--offset", f"{rng.uniform(-0.03, 0.03):.3f}", f"{rng.uniform(-0.03, 0.03):.3f}",
-                 "--yaw", f"{rng.uniform(0, 90):.0f}"],
+        "args": parcel_station(rng, (length, width, height), 1000 * seed + index, [2, 3, 4, 5],
+                               (0.8, 1.05)),
     }
 
 
