@@ -1,5 +1,7 @@
 #include "pipeline/box_fit.h"
 
+#include <spdlog/spdlog.h>
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
@@ -11,6 +13,7 @@
 #include "pipeline/key_index.h"
 #include "pipeline/median.h"
 #include "pipeline/parallel_for.h"
+#include "pipeline/rounded_edges.h"
 
 namespace boxd {
 
@@ -245,6 +248,52 @@ bool FitTop(const Points& points, const BoxFitConfig& config, const ReadingRays*
     return true;
 }
 
+// Every face reading of the fitted box `s` with how far inside its face's nearest edge it lies
+// (read where its ray meets the face, as the margins are) and how far out of the face it
+// stands, for the readings within each face's band and trim that lie beyond `margin`.
+std::vector<EdgeSample> EdgeSamples(const Points& points, const BoxFitConfig& config,
+                                    const ReadingRays* rays, double margin,
+                                    const std::array<double, 4>& band, double top_band,
+                                    bool top_observed, const BoxState& s) {
+    std::array<Eigen::Vector2d, 4> n;
+    for (int f = 0; f < 4; ++f) n[static_cast<std::size_t>(f)] = FaceNormal(s.yaw, f);
+    const double half_u = 0.5 * (s.d[0] + s.d[1]), half_v = 0.5 * (s.d[2] + s.d[3]);
+    const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);
+    const FaceChoice choice(rays, margin);
+    return ParallelCollect<EdgeSample>(
+        points.size(), config.threads,
+        [&](std::size_t begin, std::size_t end, std::vector<EdgeSample>& out) {
+            for (std::size_t i = begin; i < end; ++i) {
+                const Eigen::Vector3f& p3 = points[i];
+                const Eigen::Vector2d p = p3.head<2>().cast<double>();
+                for (int f = 0; f < 4; ++f) {
+                    const auto k = static_cast<std::size_t>(f);
+                    const double r = n[k].dot(p) - s.d[k];
+                    if (std::abs(r) > std::min(band[k], config.trim_sigmas * s.sigma[k])) {
+                        continue;
+                    }
+                    const auto x =
+                        choice.Judged(i, p3, Eigen::Vector3d(n[k].x(), n[k].y(), 0.0), s.d[k]);
+                    if (!x) continue;
+                    const Eigen::Vector2d& across = f < 2 ? n[2] : n[0];
+                    const double mid = f < 2 ? cv : cu, half = f < 2 ? half_v : half_u;
+                    const double inside =
+                        std::min({x->z(), s.height - x->z(),
+                                  half - std::abs(across.dot(x->head<2>()) - mid)});
+                    if (inside >= margin) out.push_back({inside, r});
+                }
+                if (!top_observed) continue;
+                const double r = p3.z() - s.height;
+                if (std::abs(r) > std::min(top_band, config.trim_sigmas * s.sigma[4])) continue;
+                const auto x = choice.Judged(i, p3, Eigen::Vector3d::UnitZ(), s.height);
+                if (!x) continue;
+                const double inside = std::min(half_u - std::abs(n[0].dot(x->head<2>()) - cu),
+                                               half_v - std::abs(n[2].dot(x->head<2>()) - cv));
+                if (inside >= margin) out.push_back({inside, r});
+            }
+        });
+}
+
 }  // namespace
 
 Status BoxFitConfig::Validate() const {
@@ -292,6 +341,7 @@ Result<BoxFit> FitFootprintBox(const Points& seed_points, const Points& points,
     }
     const double min_side = std::min(s.d[0] + s.d[1], s.d[2] + s.d[3]);
     const double margin = EdgeMargin(config.edge_margin_m, std::min(min_side, s.height));
+    double rounded_margin = 0.0;
     if (min_side < 2.0 * margin + 0.01 || s.height < 2.0 * margin + 0.005) {
         return Error{ErrorCode::kObjectTooSmall, "the object is too small to measure"};
     }
@@ -321,7 +371,34 @@ Result<BoxFit> FitFootprintBox(const Points& seed_points, const Points& points,
     if (top_observed && !FitTop(points, config, by_ray, margin, top_band, s, counts)) {
         top_observed = false;
     }
+    // Rounded edges reaching farther in than the margin: fitted again clear of them.
+    const double smallest = std::min({s.d[0] + s.d[1], s.d[2] + s.d[3], s.height});
+    const double rounded = RoundedEdgeMargin(
+        EdgeSamples(points, config, by_ray, margin, band, top_band, top_observed, s), margin,
+        0.25 * smallest);
+    if (rounded > margin) {
+        spdlog::debug("box fit: the faces round off; margin {:.1f} -> {:.1f} mm", margin * 1e3,
+                      rounded * 1e3);
+        const BoxState before = s;
+        const std::array<int, 5> counts_before = counts;
+        bool refitted = true;
+        for (int it = 0; it < 2 && refitted; ++it) {
+            if (top_observed && !FitTop(points, config, by_ray, rounded, top_band, s, counts)) {
+                refitted = false;
+            }
+            if (refitted && !FitSides(points, config, by_ray, rounded, band, s, counts)) {
+                refitted = false;
+            }
+        }
+        if (refitted) {
+            rounded_margin = rounded;
+        } else {
+            s = before;
+            counts = counts_before;
+        }
+    }
     BoxFit fit;
+    fit.rounded_margin_m = rounded_margin;
     fit.top_observed = top_observed;
     const double len_u = s.d[0] + s.d[1], len_v = s.d[2] + s.d[3];
     const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);

@@ -45,6 +45,9 @@ struct BoxFit {
     // False when the top had too few readings to fit (seen at grazing incidence): height_m is
     // then only the highest readings', and the sides' own ends say more (enclosing_cuboid.h).
     bool top_observed = true;
+    // Where the faces round off beyond the configured margin (EdgeMargin), how far inside their
+    // edges they were read instead (rounded_edges.h); 0 where they do not.
+    double rounded_margin_m = 0.0;
 };
 
 // Returns the footprint box of `points` (table frame, object only): minimal-area rectangle seed,

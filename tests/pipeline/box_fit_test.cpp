@@ -86,6 +86,39 @@ TEST(FitFootprintBox, FitsAFlatSmallCartonWithinItsOwnMargins) {
     EXPECT_DOUBLE_EQ(EdgeMargin(0.015, 0.30), 0.015);
 }
 
+// Samples an l x w x h box whose every edge is rounded to radius r, centred on the table's
+// axis, with Gaussian noise along the surface's normal.
+Points SampleRoundedBox(double l, double w, double h, double r, double sigma, unsigned seed) {
+    const Points sharp = SampleBox(l, w, h, 0.0, {0.0, 0.0}, 0.0, seed, 0.002);
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, sigma);
+    const Eigen::Vector3d lo(-l / 2 + r, -w / 2 + r, r), hi(l / 2 - r, w / 2 - r, h - r);
+    Points out;
+    for (const Eigen::Vector3f& p : sharp) {
+        const Eigen::Vector3d q = p.cast<double>().cwiseMax(lo).cwiseMin(hi);
+        const Eigen::Vector3d d = p.cast<double>() - q;
+        if (d.norm() < 1e-9) continue;
+        out.push_back((q + (r + noise(rng)) * d.normalized()).cast<float>());
+    }
+    return out;
+}
+
+TEST(FitFootprintBox, ReadsRoundedEdgesBeyondTheMarginClearOfTheirRounding) {
+    // 30 mm rounding: 15 mm inside an edge the surface lies 4 mm inside the face.
+    const Points pts = SampleRoundedBox(0.40, 0.30, 0.25, 0.03, 0.001, 11);
+    auto fit = FitFootprintBox(pts, BoxFitConfig{});
+    ASSERT_TRUE(fit.ok()) << fit.error().message;
+    EXPECT_GE(fit->rounded_margin_m, 0.025);
+    EXPECT_NEAR(fit->length_m, 0.40, 0.0002);
+    EXPECT_NEAR(fit->width_m, 0.30, 0.0002);
+    EXPECT_NEAR(fit->height_m, 0.25, 0.0002);
+    // The same box with sharp edges keeps the configured margin.
+    auto sharp = FitFootprintBox(SampleBox(0.40, 0.30, 0.25, 0.0, {0.0, 0.0}, 0.001, 11, 0.002),
+                                 BoxFitConfig{});
+    ASSERT_TRUE(sharp.ok()) << sharp.error().message;
+    EXPECT_EQ(sharp->rounded_margin_m, 0.0);
+}
+
 TEST(FitFootprintBox, RefusesTinyObject) {
     const Points pts = SampleBox(0.02, 0.02, 0.02, 0.0, {0.0, 0.0}, 0.0, 4, 0.002);
     auto fit = FitFootprintBox(pts, BoxFitConfig{});
