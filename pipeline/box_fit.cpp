@@ -250,7 +250,11 @@ bool FitTop(const Points& points, const BoxFitConfig& config, const ReadingRays*
 
 // Every face reading of the fitted box `s` with how far inside its face's nearest edge it lies
 // (read where its ray meets the face, as the margins are) and how far out of the face it
-// stands, for the readings within each face's band and trim that lie beyond `margin`.
+// stands, for the readings beyond `margin`: outwards within each face's band and trim, inwards
+// within the first pass's band (a rounding falls millimetres inside the face: 14 mm at the
+// 15 mm margin for a radius of 50 mm) and no deeper than they lie inside the edge, as deep as
+// any circular rounding reaches there (at e inside, r - sqrt(r² - (r - e)²) <= e): deeper ones
+// are another face's, seen past the edge.
 std::vector<EdgeSample> EdgeSamples(const Points& points, const BoxFitConfig& config,
                                     const ReadingRays* rays, double margin,
                                     const std::array<double, 4>& band, double top_band,
@@ -269,7 +273,8 @@ std::vector<EdgeSample> EdgeSamples(const Points& points, const BoxFitConfig& co
                 for (int f = 0; f < 4; ++f) {
                     const auto k = static_cast<std::size_t>(f);
                     const double r = n[k].dot(p) - s.d[k];
-                    if (std::abs(r) > std::min(band[k], config.trim_sigmas * s.sigma[k])) {
+                    if (r > std::min(band[k], config.trim_sigmas * s.sigma[k]) ||
+                        r < -config.initial_band_m) {
                         continue;
                     }
                     const auto x =
@@ -280,16 +285,19 @@ std::vector<EdgeSample> EdgeSamples(const Points& points, const BoxFitConfig& co
                     const double inside =
                         std::min({x->z(), s.height - x->z(),
                                   half - std::abs(across.dot(x->head<2>()) - mid)});
-                    if (inside >= margin) out.push_back({inside, r});
+                    if (inside >= margin && -r <= inside) out.push_back({inside, r});
                 }
                 if (!top_observed) continue;
                 const double r = p3.z() - s.height;
-                if (std::abs(r) > std::min(top_band, config.trim_sigmas * s.sigma[4])) continue;
+                if (r > std::min(top_band, config.trim_sigmas * s.sigma[4]) ||
+                    r < -config.initial_band_m) {
+                    continue;
+                }
                 const auto x = choice.Judged(i, p3, Eigen::Vector3d::UnitZ(), s.height);
                 if (!x) continue;
                 const double inside = std::min(half_u - std::abs(n[0].dot(x->head<2>()) - cu),
                                                half_v - std::abs(n[2].dot(x->head<2>()) - cv));
-                if (inside >= margin) out.push_back({inside, r});
+                if (inside >= margin && -r <= inside) out.push_back({inside, r});
             }
         });
 }

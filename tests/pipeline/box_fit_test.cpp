@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <random>
+#include <utility>
 #include <vector>
 
 namespace boxd {
@@ -104,14 +105,18 @@ Points SampleRoundedBox(double l, double w, double h, double r, double sigma, un
 }
 
 TEST(FitFootprintBox, ReadsRoundedEdgesBeyondTheMarginClearOfTheirRounding) {
-    // 30 mm rounding: 15 mm inside an edge the surface lies 4 mm inside the face.
-    const Points pts = SampleRoundedBox(0.40, 0.30, 0.25, 0.03, 0.001, 11);
-    auto fit = FitFootprintBox(pts, BoxFitConfig{});
-    ASSERT_TRUE(fit.ok()) << fit.error().message;
-    EXPECT_GE(fit->rounded_margin_m, 0.025);
-    EXPECT_NEAR(fit->length_m, 0.40, 0.0002);
-    EXPECT_NEAR(fit->width_m, 0.30, 0.0002);
-    EXPECT_NEAR(fit->height_m, 0.25, 0.0002);
+    // Roundings of 30 and 50 mm (15 mm inside an edge the surface lies 4 and 14 mm inside the
+    // face), with 1 mm of noise and with 0.3 mm.
+    for (const auto& [r, sigma] : {std::pair{0.03, 0.001}, std::pair{0.05, 0.001},
+                                   std::pair{0.03, 0.0003}, std::pair{0.05, 0.0003}}) {
+        const Points pts = SampleRoundedBox(0.40, 0.30, 0.25, r, sigma, 11);
+        auto fit = FitFootprintBox(pts, BoxFitConfig{});
+        ASSERT_TRUE(fit.ok()) << fit.error().message;
+        EXPECT_GE(fit->rounded_margin_m, r - 0.005 - 1e-9) << r << " " << sigma;
+        EXPECT_NEAR(fit->length_m, 0.40, 0.0002) << r << " " << sigma;
+        EXPECT_NEAR(fit->width_m, 0.30, 0.0002) << r << " " << sigma;
+        EXPECT_NEAR(fit->height_m, 0.25, 0.0002) << r << " " << sigma;
+    }
     // The same box with sharp edges keeps the configured margin.
     auto sharp = FitFootprintBox(SampleBox(0.40, 0.30, 0.25, 0.0, {0.0, 0.0}, 0.001, 11, 0.002),
                                  BoxFitConfig{});

@@ -41,7 +41,8 @@ TEST(RoundedEdgeMargin, ARoundedEdgeMovesTheMarginPastItsRounding) {
         const double m =
             RoundedEdgeMargin(Samples([r](double e) { return Rounded(r, e); }, 7), kMargin, kCap);
         // Past where the rounding falls by more than the noise can show, within a step of r.
-        EXPECT_GE(m, r - kMargin / 3.0) << r;
+        EXPECT_GT(m, kMargin + 1e-9) << r;
+        EXPECT_GE(m, r - kMargin / 3.0 - 1e-9) << r;
         EXPECT_LE(m, r + 1e-9) << r;
     }
     // Beyond the cap: the cap is not passed, and a face rounded all the way is a curved one.
@@ -61,15 +62,21 @@ TEST(RoundedEdgeMargin, LabelsStrapsAndBulgesAreNotRounding) {
         RoundedEdgeMargin(Samples([](double e) { return e > 0.025 && e < 0.06 ? 0.001 : 0.0; }, 9),
                           kMargin, kCap),
         0.025 + 1e-9);
-    // A face bulging 4 mm at its middle, 200 mm across: it falls all the way to the edge.
-    EXPECT_DOUBLE_EQ(RoundedEdgeMargin(Samples(
-                                           [](double e) {
-                                               const double x = std::min(e, 0.1) / 0.1;
-                                               return 0.004 * (x * (2.0 - x)) - 0.004;
-                                           },
-                                           10),
-                                       kMargin, kCap),
-                     kMargin);
+    // Faces bulging 1-4 mm at their middle, 200 and 400 mm across: they fall inwards all the
+    // way to the edge, more steeply towards it, and go on rising past any step the noise stops
+    // the walk at.
+    for (double bulge : {0.001, 0.002, 0.004}) {
+        for (double across : {0.2, 0.4}) {
+            for (unsigned seed = 1; seed <= 5; ++seed) {
+                const auto bulging = [bulge, across](double e) {
+                    const double x = std::min(e, across / 2) / (across / 2);
+                    return bulge * (x * (2.0 - x)) - bulge;
+                };
+                EXPECT_DOUBLE_EQ(RoundedEdgeMargin(Samples(bulging, seed), kMargin, kCap), kMargin)
+                    << bulge << " " << across << " " << seed;
+            }
+        }
+    }
 }
 
 }  // namespace

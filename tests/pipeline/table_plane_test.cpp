@@ -209,39 +209,60 @@ std::vector<DepthMap> NoisyPoses(int poses, double pixel_sigma, double pose_sigm
     return out;
 }
 
-// The centre's predicted standard error over its true scatter (root mean squares over
-// `trials` draws of `draw(trial)`'s depth maps; the true table is the recorded one). Nothing
-// when a fit fails.
+// The centre's height error over `trials` draws of `draw(trial)`'s depth maps (the true table
+// is the recorded one): its mean, its spread about the mean, its root mean square, and the
+// predicted standard error's root mean square. Nothing when a fit fails.
+struct CentreErrors {
+    double mean = 0.0, spread = 0.0, rms = 0.0, predicted = 0.0;
+};
+
 template <typename Draw>
-std::optional<double> PredictedOverTrue(int trials, Draw draw) {
+std::optional<CentreErrors> CentreErrorsOver(int trials, Draw draw) {
     const CameraIntrinsics cam;
-    double squared_error = 0.0, predicted = 0.0;
+    std::vector<double> errors;
+    double predicted = 0.0;
     for (int t = 0; t < trials; ++t) {
         const auto fit = FitTablePlane(draw(t), cam, Recorded(), TablePlaneConfig{});
         if (!fit.ok()) return std::nullopt;
-        squared_error += fit->height_correction_m * fit->height_correction_m;
+        errors.push_back(fit->height_correction_m);
         predicted += fit->center_se_m * fit->center_se_m;
     }
-    return std::sqrt(predicted / squared_error);
+    CentreErrors out;
+    const auto n = static_cast<double>(trials);
+    for (double e : errors) out.mean += e / n;
+    for (double e : errors) {
+        out.spread += (e - out.mean) * (e - out.mean) / (n - 1.0);
+        out.rms += e * e / n;
+    }
+    out.spread = std::sqrt(out.spread);
+    out.rms = std::sqrt(out.rms);
+    out.predicted = std::sqrt(predicted / n);
+    std::printf(
+        "centre error: mean %+.4f mm, spread %.4f mm, rms %.4f mm; standard error %.4f mm\n",
+        out.mean * 1e3, out.spread * 1e3, out.rms * 1e3, out.predicted * 1e3);
+    return out;
 }
 
 TEST(FitTablePlane, CentreStandardErrorIsWhatThePosesScatterSays) {
     // Readings a millimetre apart and poses 0.1 mm apart: the plane's height at the centre errs
     // by about 0.1 mm over the root of the poses, which the readings' own scatter over their
     // count (tens of thousands) would put ten times too small.
-    const auto ratio = PredictedOverTrue(
+    const auto e = CentreErrorsOver(
         32, [](int t) { return NoisyPoses(8, 0.001, 0.0001, 900 + static_cast<unsigned>(t)); });
-    ASSERT_TRUE(ratio.has_value());
-    std::printf("centre standard error over the true scatter: %.2f\n", *ratio);
-    EXPECT_GT(*ratio, 0.6);
-    EXPECT_LT(*ratio, 1.6);
+    ASSERT_TRUE(e.has_value());
+    EXPECT_GT(e->predicted, 0.6 * e->rms);
+    EXPECT_LT(e->predicted, 1.6 * e->rms);
 }
 
 TEST(FitTablePlane, CentreStandardErrorHoldsWhereABoxHidesTheCentre) {
     // A 0.6 x 0.4 m box over the centre, a quarter turn further at every pose and 5 cm off the
     // axis: each pose sees the table on the side the box leaves open, and its own plane reaches
-    // the centre by its tilt. The pooled plane's height there is what the error is about.
-    const auto ratio = PredictedOverTrue(24, [](int t) {
+    // the centre by its tilt. Most of the pooled plane's error here is shared by every pose
+    // (about 0.1 mm, and none without the noise: the walls' foot within the table's band),
+    // which no resampling over the poses shows; its spread is a seventh of that. The standard
+    // error must cover the spread and, as the bound's part, not exceed the whole error by much:
+    // each pose's own plane put it at 2.5 times the whole error, the jackknife at 0.8.
+    const auto e = CentreErrorsOver(24, [](int t) {
         const CameraIntrinsics cam;
         const int poses = 8;
         std::mt19937 rng(1700 + static_cast<unsigned>(t));
@@ -262,10 +283,9 @@ TEST(FitTablePlane, CentreStandardErrorHoldsWhereABoxHidesTheCentre) {
         }
         return depths;
     });
-    ASSERT_TRUE(ratio.has_value());
-    std::printf("centre standard error over the true scatter, box over the centre: %.2f\n", *ratio);
-    EXPECT_GT(*ratio, 0.6);
-    EXPECT_LT(*ratio, 1.6);
+    ASSERT_TRUE(e.has_value());
+    EXPECT_GT(e->predicted, e->spread);
+    EXPECT_LT(e->predicted, 1.6 * e->rms);
 }
 
 TEST(FitTablePlane, OnePoseGivesItsReadingsOwnStandardError) {
