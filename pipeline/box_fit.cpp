@@ -9,45 +9,23 @@
 #include <opencv2/imgproc.hpp>
 #include <vector>
 
+#include "pipeline/box_faces.h"
 #include "pipeline/face_choice.h"
 #include "pipeline/key_index.h"
-#include "pipeline/median.h"
-#include "pipeline/parallel_for.h"
 #include "pipeline/rounded_edges.h"
 
 namespace boxd {
 
 namespace {
 
+using box_faces::BoxState;
+using box_faces::EdgeSamples;
+using box_faces::FaceNormal;
+using box_faces::FitSides;
+using box_faces::FitTop;
+
 Status Bad(const std::string& field, const std::string& why) {
     return Error{ErrorCode::kInvalidConfig, "box_fit." + field + ": " + why};
-}
-
-// 1.4826 * the median absolute deviation from `center`: the standard deviation of normally
-// distributed values about it.
-double MadSigma(const std::vector<double>& values, double center) {
-    std::vector<double> a(values.size());
-    for (std::size_t i = 0; i < a.size(); ++i) a[i] = std::abs(values[i] - center);
-    return 1.4826 * Median(std::move(a));
-}
-
-// The same about the residuals' own median.
-double RobustSigma(const std::vector<double>& residuals) {
-    return MadSigma(residuals, Median(residuals));
-}
-
-// The box in its own footprint frame: u along `yaw`, v perpendicular, origin at the table.
-struct BoxState {
-    double yaw = 0.0;
-    // Outward offsets of the side faces along +u, -u, +v, -v: face f is {p : n_f · p = d_f}.
-    std::array<double, 4> d{};
-    double height = 0.0;
-    std::array<double, 5> sigma{};  // robust sigma per face (sides, top)
-};
-
-Eigen::Vector2d FaceNormal(double yaw, int face) {
-    const double a = yaw + (face == 0 ? 0.0 : face == 1 ? M_PI : face == 2 ? M_PI / 2 : -M_PI / 2);
-    return {std::cos(a), std::sin(a)};
 }
 
 // Returns the footprint seed: the minimal-area rectangle of the occupied footprint cells.
@@ -101,207 +79,6 @@ Result<BoxState> SeedFootprint(const Points& points, const BoxFitConfig& config)
     }
     return s;
 }
-
-struct FacePoint {
-    int face;
-    Eigen::Vector2d xy;
-};
-
-// One pass of the side-face fit: selects the points in each face's band (away from the edges),
-// then solves the linearised least squares for a common yaw and the four offsets, trimming
-// outliers once. Returns false when a face has too few points.
-bool FitSides(const Points& points, const BoxFitConfig& config, const ReadingRays* rays,
-              double margin, const std::array<double, 4>& band, BoxState& s,
-              std::array<int, 5>& counts) {
-    std::array<Eigen::Vector2d, 4> n;
-    for (int f = 0; f < 4; ++f) n[static_cast<std::size_t>(f)] = FaceNormal(s.yaw, f);
-    const double half_u = 0.5 * (s.d[0] + s.d[1]), half_v = 0.5 * (s.d[2] + s.d[3]);
-    const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);
-    const FaceChoice choice(rays, margin);
-    const double m = choice.margin(), gate = choice.gate();
-    const std::vector<FacePoint> sel = ParallelCollect<FacePoint>(
-        points.size(), config.threads,
-        [&](std::size_t begin, std::size_t end, std::vector<FacePoint>& out) {
-            for (std::size_t i = begin; i < end; ++i) {
-                const Eigen::Vector3f& p3 = points[i];
-                if (p3.z() < gate || p3.z() > s.height - gate) continue;
-                const Eigen::Vector2d p = p3.head<2>().cast<double>();
-                for (int f = 0; f < 4; ++f) {
-                    const auto k = static_cast<std::size_t>(f);
-                    const double r = n[k].dot(p) - s.d[k];
-                    if (std::abs(r) > band[k]) continue;
-                    const Eigen::Vector2d& across = f < 2 ? n[2] : n[0];
-                    const double mid = f < 2 ? cv : cu, half = f < 2 ? half_v : half_u;
-                    if (std::abs(across.dot(p) - mid) > half - gate) continue;
-                    const auto x =
-                        choice.Judged(i, p3, Eigen::Vector3d(n[k].x(), n[k].y(), 0.0), s.d[k]);
-                    if (!x || x->z() < m || x->z() > s.height - m ||
-                        std::abs(across.dot(x->head<2>()) - mid) > half - m) {
-                        continue;
-                    }
-                    out.push_back({f, p});
-                }
-            }
-        });
-    auto solve = [&](const std::vector<char>& use, std::array<int, 5>& cnt) {
-        // Unknowns: dyaw, dd0..dd3. r + (n'·p) dyaw - dd_f = 0.
-        Eigen::Matrix<double, 5, 5> h = Eigen::Matrix<double, 5, 5>::Zero();
-        Eigen::Matrix<double, 5, 1> g = Eigen::Matrix<double, 5, 1>::Zero();
-        cnt.fill(0);
-        for (std::size_t i = 0; i < sel.size(); ++i) {
-            if (!use[i]) continue;
-            const auto k = static_cast<std::size_t>(sel[i].face);
-            const Eigen::Vector2d nd(-n[k].y(), n[k].x());
-            const double r = n[k].dot(sel[i].xy) - s.d[k];
-            // The Jacobian row has two entries, j0 and -1 at 1 + k: only the terms they touch
-            // (h is symmetric; its lower triangle is all ldlt reads).
-            const double j0 = nd.dot(sel[i].xy);
-            const long f = 1 + static_cast<long>(k);
-            h(0, 0) += j0 * j0;
-            h(f, 0) -= j0;
-            h(f, f) += 1.0;
-            g(0) += j0 * r;
-            g(f) -= r;
-            ++cnt[k];
-        }
-        h.diagonal().array() += 1e-12;
-        return Eigen::Matrix<double, 5, 1>(h.ldlt().solve(-g));
-    };
-    std::vector<char> use(sel.size(), 1);
-    std::array<int, 5> cnt{};
-    Eigen::Matrix<double, 5, 1> delta = solve(use, cnt);
-    // Trim per face with the robust sigma of the residuals after the first solve.
-    std::array<std::vector<double>, 4> res;
-    std::vector<double> r_all(sel.size());
-    for (std::size_t i = 0; i < sel.size(); ++i) {
-        const auto k = static_cast<std::size_t>(sel[i].face);
-        const Eigen::Vector2d nd(-n[k].y(), n[k].x());
-        r_all[i] = n[k].dot(sel[i].xy) - s.d[k] + nd.dot(sel[i].xy) * delta(0) - delta(1 + k);
-        res[k].push_back(r_all[i]);
-    }
-    std::array<double, 4> sig{};
-    // Four medians of tens of thousands of residuals each: the bulk of the fit's time.
-    ParallelFor(4, config.threads, [&](int f) {
-        const auto k = static_cast<std::size_t>(f);
-        sig[k] = std::max(RobustSigma(res[k]), 1e-4);
-    });
-    for (std::size_t i = 0; i < sel.size(); ++i) {
-        const auto k = static_cast<std::size_t>(sel[i].face);
-        use[i] = std::abs(r_all[i]) <= config.trim_sigmas * sig[k];
-    }
-    delta = solve(use, cnt);
-    for (std::size_t k = 0; k < 4; ++k) {
-        counts[k] = cnt[k];
-        s.sigma[k] = sig[k];
-    }
-    if (*std::min_element(cnt.begin(), cnt.begin() + 4) < config.min_face_points) return false;
-    // The offsets are relative to the old yaw's normals; the normals rotate with the yaw, which
-    // is what the linearisation assumed, so the offsets apply as they are.
-    s.yaw += delta(0);
-    for (std::size_t k = 0; k < 4; ++k) s.d[k] += delta(1 + static_cast<long>(k));
-    return true;
-}
-
-// Top face: trimmed mean height of the points inside the footprint (away from its edges) and in
-// the band around the current height estimate.
-bool FitTop(const Points& points, const BoxFitConfig& config, const ReadingRays* rays,
-            double margin, double band, BoxState& s, std::array<int, 5>& counts) {
-    const Eigen::Vector2d nu = FaceNormal(s.yaw, 0), nv = FaceNormal(s.yaw, 2);
-    const double half_u = 0.5 * (s.d[0] + s.d[1]), half_v = 0.5 * (s.d[2] + s.d[3]);
-    const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);
-    const FaceChoice choice(rays, margin);
-    const double m = choice.margin(), gate = choice.gate();
-    auto inside = [&](const Eigen::Vector2d& p, double inset) {
-        return std::abs(nu.dot(p) - cu) <= half_u - inset &&
-               std::abs(nv.dot(p) - cv) <= half_v - inset;
-    };
-    const std::vector<double> z = ParallelCollect<double>(
-        points.size(), config.threads,
-        [&](std::size_t begin, std::size_t end, std::vector<double>& out) {
-            for (std::size_t i = begin; i < end; ++i) {
-                const Eigen::Vector3f& p3 = points[i];
-                if (std::abs(p3.z() - s.height) > band) continue;
-                if (!inside(p3.head<2>().cast<double>(), gate)) continue;
-                const auto x = choice.Judged(i, p3, Eigen::Vector3d::UnitZ(), s.height);
-                if (!x || !inside(x->head<2>(), m)) continue;
-                out.push_back(p3.z());
-            }
-        });
-    if (static_cast<int>(z.size()) < config.min_face_points) {
-        counts[4] = static_cast<int>(z.size());
-        return false;
-    }
-    const double med = Median(z);
-    const double sig = std::max(MadSigma(z, med), 1e-4);
-    double sum = 0.0;
-    int n = 0;
-    for (double v : z) {
-        if (std::abs(v - med) <= config.trim_sigmas * sig) {
-            sum += v;
-            ++n;
-        }
-    }
-    counts[4] = n;
-    if (n < config.min_face_points) return false;
-    s.height = sum / n;
-    s.sigma[4] = sig;
-    return true;
-}
-
-// Every face reading of the fitted box `s` with how far inside its face's nearest edge it lies
-// (read where its ray meets the face, as the margins are) and how far out of the face it
-// stands, for the readings beyond `margin`: outwards within each face's band and trim, inwards
-// within the first pass's band (a rounding falls millimetres inside the face: 14 mm at the
-// 15 mm margin for a radius of 50 mm) and no deeper than they lie inside the edge, as deep as
-// any circular rounding reaches there (at e inside, r - sqrt(r² - (r - e)²) <= e): deeper ones
-// are another face's, seen past the edge.
-std::vector<EdgeSample> EdgeSamples(const Points& points, const BoxFitConfig& config,
-                                    const ReadingRays* rays, double margin,
-                                    const std::array<double, 4>& band, double top_band,
-                                    bool top_observed, const BoxState& s) {
-    std::array<Eigen::Vector2d, 4> n;
-    for (int f = 0; f < 4; ++f) n[static_cast<std::size_t>(f)] = FaceNormal(s.yaw, f);
-    const double half_u = 0.5 * (s.d[0] + s.d[1]), half_v = 0.5 * (s.d[2] + s.d[3]);
-    const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);
-    const FaceChoice choice(rays, margin);
-    return ParallelCollect<EdgeSample>(
-        points.size(), config.threads,
-        [&](std::size_t begin, std::size_t end, std::vector<EdgeSample>& out) {
-            for (std::size_t i = begin; i < end; ++i) {
-                const Eigen::Vector3f& p3 = points[i];
-                const Eigen::Vector2d p = p3.head<2>().cast<double>();
-                for (int f = 0; f < 4; ++f) {
-                    const auto k = static_cast<std::size_t>(f);
-                    const double r = n[k].dot(p) - s.d[k];
-                    if (r > std::min(band[k], config.trim_sigmas * s.sigma[k]) ||
-                        r < -config.initial_band_m) {
-                        continue;
-                    }
-                    const auto x =
-                        choice.Judged(i, p3, Eigen::Vector3d(n[k].x(), n[k].y(), 0.0), s.d[k]);
-                    if (!x) continue;
-                    const Eigen::Vector2d& across = f < 2 ? n[2] : n[0];
-                    const double mid = f < 2 ? cv : cu, half = f < 2 ? half_v : half_u;
-                    const double inside =
-                        std::min({x->z(), s.height - x->z(),
-                                  half - std::abs(across.dot(x->head<2>()) - mid)});
-                    if (inside >= margin && -r <= inside) out.push_back({inside, r});
-                }
-                if (!top_observed) continue;
-                const double r = p3.z() - s.height;
-                if (r > std::min(top_band, config.trim_sigmas * s.sigma[4]) ||
-                    r < -config.initial_band_m) {
-                    continue;
-                }
-                const auto x = choice.Judged(i, p3, Eigen::Vector3d::UnitZ(), s.height);
-                if (!x) continue;
-                const double inside = std::min(half_u - std::abs(n[0].dot(x->head<2>()) - cu),
-                                               half_v - std::abs(n[2].dot(x->head<2>()) - cv));
-                if (inside >= margin && -r <= inside) out.push_back({inside, r});
-            }
-        });
-}
-
 }  // namespace
 
 Status BoxFitConfig::Validate() const {

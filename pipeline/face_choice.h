@@ -31,6 +31,12 @@ inline double EdgeMargin(double configured_m, double smallest_extent_m) {
     return std::min(configured_m, 0.25 * std::max(smallest_extent_m, 0.0));
 }
 
+// The same for a fitted box whose faces round off farther in than that (`rounded_m`,
+// BoxFit::rounded_margin_m, rounded_edges.h; 0 where they do not): its faces are read beyond it.
+inline double EdgeMargin(double configured_m, double smallest_extent_m, double rounded_m) {
+    return std::max(EdgeMargin(configured_m, smallest_extent_m), rounded_m);
+}
+
 // Which readings a face fit takes. Axial noise moves a reading along its ray, so where a face is
 // seen obliquely it moves the reading along the face as much as across it: a margin from the
 // face's edges read at the reading's position keeps, at each end of the face, the readings their

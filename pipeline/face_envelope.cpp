@@ -251,8 +251,8 @@ std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& b
                                         const EnvelopeConfig& config) {
     const Eigen::Vector2d a = box.length_axis, b(-a.y(), a.x());
     const double hl = box.length_m / 2.0, hw = box.width_m / 2.0, h = box.height_m;
-    const double m = std::max(EdgeMargin(config.edge_margin_m, std::min(box.width_m, box.height_m)),
-                              box.rounded_margin_m);
+    const double m =
+        EdgeMargin(config.edge_margin_m, std::min(box.width_m, box.height_m), box.rounded_margin_m);
     const double inward = std::max(config.inward_band_sigmas * box.face_sigma_m, 0.004);
     using Grid = CellGrid<CellStats>;
     std::array<Grid, 5> grids = {

@@ -142,15 +142,15 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
         // the table meet alike (depth_rounding.h): the two surfaces lie at other depths, so
         // their roundings are independent.
         const double unit = session.camera.depth_unit_m;
-        const double rounding = std::hypot(
-            SharedRoundingSigma(
-                TopRounding(fit.fused, registered->poses, *cuboid, table.camera_to_table,
-                            session.calibration, config.box_fit.min_band_m,
-                            std::max(EdgeMargin(config.envelope.edge_margin_m,
-                                                std::min(cuboid->width_m, cuboid->height_m)),
-                                     fit.box ? fit.box->rounded_margin_m : 0.0)),
-                unit),
-            SharedRoundingSigma(table.rounding, unit));
+        const double rounding =
+            std::hypot(SharedRoundingSigma(
+                           TopRounding(fit.fused, registered->poses, *cuboid, table.camera_to_table,
+                                       session.calibration, config.box_fit.min_band_m,
+                                       EdgeMargin(config.envelope.edge_margin_m,
+                                                  std::min(cuboid->width_m, cuboid->height_m),
+                                                  fit.box ? fit.box->rounded_margin_m : 0.0)),
+                           unit),
+                       SharedRoundingSigma(table.rounding, unit));
         spdlog::debug("uncertainty: the depths' rounding {:.3f} mm in the height", rounding * 1e3);
         const double shared[3] = {moved[0], moved[1], std::hypot(table.center_se_m, rounding)};
         for (std::size_t i = 0; i < 3; ++i) {
