@@ -58,6 +58,9 @@ Error AsCalibrationRefusal(const MeasurementReason& why) {
     }
 }
 
+// A centre the calibration knows nothing of, as a sigma: a metre, beyond any table.
+constexpr double kUnknownCenterSigmaM = 1.0;
+
 // The measurement recipe's stages 1 to 6 with the recorded calibration (the same calls, the
 // same refusal rules), then the origin moved to the turntable centre the registered views
 // rotate about.
@@ -78,8 +81,11 @@ Result<InitialEstimate> EstimateInitial(const Session& session, const MeasureCon
     if (auto why = CheckObjectViews(views, mc.refusal)) return AsCalibrationRefusal(*why);
 
     const int n = static_cast<int>(session.poses.size());
-    auto registered = RegisterViews(views.clouds, session.PoseAnglesRad(), mc.registration,
-                                    mc.pose_graph, nullptr);
+    // The recorded centre is what the calibration finds: the solve takes no word from it.
+    PoseGraphConfig graph = mc.pose_graph;
+    graph.calibration_center_sigma_m = kUnknownCenterSigmaM;
+    auto registered =
+        RegisterViews(views.clouds, session.PoseAnglesRad(), mc.registration, graph, nullptr);
     if (!registered) return AsCalibrationRefusal(registered.error());
     if (auto why = CheckRegisteredViews(*registered, n, mc.refusal)) {
         return AsCalibrationRefusal(*why);

@@ -19,11 +19,13 @@ struct PoseGraphConfig {
     double prior_center_sigma_m = 0.001;
     // How well the recorded calibration placed the table's centre (1-sigma per in-plane axis):
     // a prior on the estimated centre offset, at this weight whatever the residuals show (they
-    // say nothing of it). Where the alignments fix the centre (most rings of views) it hardly
-    // counts; where they leave a direction of it free (four views a quarter turn apart share
-    // one face each, and every alignment leaves its slide along it to the model), the centre
-    // there, and every pose with it, is known only as well as the calibration put it, and the
-    // poses' covariance says so. `boxd calibrate` places it to a few tenths of a millimetre.
+    // say nothing of it). Where the alignments fix the centre (most rings of views) it does not
+    // count; where they leave a direction of it free (four views a quarter turn apart share one
+    // face each, and every alignment leaves its slide along it to the model), the centre there,
+    // and every pose with it, is known only as well as the calibration put it, and the poses'
+    // covariance says so (PoseGraph::centre_from_calibration). `boxd calibrate` places it to a
+    // few tenths of a millimetre; a station's config says how well (the simulated station's
+    // recorded centre is 3 mm off: config/sim.yaml).
     double calibration_center_sigma_m = 0.001;
     // Edges are weighted by their surface displacement (IcpResult::point_scatter) over this
     // sigma: ICP errors are correlated across points, so JᵀJ / sigma² would be overconfident.
@@ -72,8 +74,8 @@ struct PoseEdge {
     double random_displacement_m = 0.0;
     double evidence_weight = 1.0;
     // The in-plane direction (x, y, the `from` view's frame) along which the alignment kept its
-    // start, the turntable model's (IcpResult::slide), or zero. The solve keeps the model there;
-    // the poses' covariance counts it as unmeasured (PoseCovariance).
+    // start, the turntable model's (IcpResult::slide), or zero: no measurement (PoseGraph::
+    // centre_from_calibration says what the solve and the covariance make of it).
     Eigen::Vector2d slide = Eigen::Vector2d::Zero();
 };
 
@@ -83,6 +85,14 @@ struct PoseGraph {
     std::vector<double> commanded_yaw;  // the turntable model's pose yaw (minus the table angle)
     std::vector<PoseEdge> edges;
     Eigen::Vector2d center_offset = Eigen::Vector2d::Zero();  // estimated axis offset
+    // Where the table's centre comes from. From the alignments (false): the edges count
+    // nothing along their slides, in the solve and the covariance alike, and the calibration's
+    // centre not at all. From the calibration (true, where the alignments know the centre less
+    // well than it along some direction: CalibrationCounts): the solve keeps each slide at the
+    // model's place, the turntable about the recorded centre, and the covariance counts that as
+    // the calibration's word on the centre (calibration_center_sigma_m) instead.
+    // OptimizePoseGraph sets it.
+    bool centre_from_calibration = true;
 };
 
 struct PoseGraphReport {
@@ -93,6 +103,14 @@ struct PoseGraphReport {
     double max_model_translation_deviation_m = 0.0;
     int unconstrained_nodes = 0;  // nodes without any kept edge
 };
+
+// Whether the alignments and the turntable prior of `graph`, without the edges' slides, at its
+// poses and the sigmas of `config`, leave the table's centre less well known than the
+// calibration says it is (calibration_center_sigma_m) along some direction: the Schur
+// complement of their information on the centre, against the calibration's. Where they know it
+// better, the centre comes from them (PoseGraph::centre_from_calibration); where they do not
+// (four views a quarter turn apart leave a direction free), the calibration is all there is.
+bool CalibrationCounts(const PoseGraph& graph, const PoseGraphConfig& config);
 
 // Solves `graph` once with the edges not marked rejected; updates poses and centre offset.
 Status SolvePoseGraph(PoseGraph& graph, const PoseGraphConfig& config);

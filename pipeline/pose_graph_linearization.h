@@ -13,8 +13,8 @@ namespace boxd::pose_graph_internal {
 
 // The whitened residuals and their Jacobian at the graph's solution, with respect to nodes
 // 1..n-1 and the centre offset (node 0 is the gauge). The residual blocks come in BuildProblem's
-// order: the kept edges' rows, then the priors' (and for the covariance the calibration's two on
-// the centre, with the edges counting nothing along their slides). Each row touches at most two
+// order: the kept edges' rows, then the priors', then (for the covariance of a centre that comes
+// from the calibration) the calibration's two on the centre. Each row touches at most two
 // nodes and the centre, so the Jacobian stays sparse: with 360 poses it has ~4,000 rows of 1,079
 // columns.
 struct Linearization {
@@ -24,9 +24,8 @@ struct Linearization {
     int prior_rows = 0;  // the turntable prior's, after the edges'
 };
 
-// What the problem is built for: the solve, where an edge keeps its information along its slide
-// (the model's place, where the solve should keep it), or the poses' covariance, where that
-// information is the calibration's, counted once, on the centre (PoseCovariance).
+// What the problem is built for: the solve or the poses' covariance, which differ where the
+// centre comes from the calibration (PoseGraph::centre_from_calibration).
 enum class Purpose { kSolve, kCovariance };
 
 // Returns the linearisation at the graph's poses, or nothing when Ceres cannot evaluate it.
@@ -41,6 +40,7 @@ std::optional<Linearization> Linearize(const PoseGraph& graph, const PoseGraphCo
 // the edges hardly fix: the table's centre along the camera's line of sight, which moves every
 // face alike (a 0.6 m box grew by 0.5 mm on a table with 0.3-degree angle errors). Weighed by
 // what their residuals show, each source counts as much as it is worth on this capture.
-Status SolveWeighedByTheData(PoseGraph& graph, const PoseGraphConfig& config);
+Status SolveWeighedByTheData(PoseGraph& graph, const PoseGraphConfig& config,
+                             PoseGraphConfig* weighed_out);
 
 }  // namespace boxd::pose_graph_internal

@@ -1,5 +1,6 @@
 #include <spdlog/spdlog.h>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <array>
@@ -241,6 +242,32 @@ Eigen::MatrixXd PoseCovariance(const PoseGraph& graph, const PoseGraphConfig& co
     return cov;
 }
 
+bool CalibrationCounts(const PoseGraph& graph, const PoseGraphConfig& config) {
+    const int n = static_cast<int>(graph.poses.size());
+    if (n < 2) return true;
+    PoseGraph without = graph;
+    without.centre_from_calibration = false;
+    const auto lin = pose_graph_internal::Linearize(without, config);
+    if (!lin) return true;
+    // The normal matrix's node block and its centre columns (the last two).
+    const Eigen::SparseMatrix<double> normal =
+        Eigen::SparseMatrix<double>(lin->jacobian.transpose()) * lin->jacobian;
+    const Eigen::Index m = normal.cols() - 2;
+    const Eigen::SparseMatrix<double> nodes = normal.topLeftCorner(m, m);
+    const Eigen::MatrixXd cross = Eigen::MatrixXd(normal.topRightCorner(m, 2));
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(nodes);
+    if (ldlt.info() != Eigen::Success) return true;
+    const Eigen::MatrixXd solved = ldlt.solve(cross);
+    if (ldlt.info() != Eigen::Success) return true;
+    const Eigen::Matrix2d centre =
+        Eigen::MatrixXd(normal.bottomRightCorner(2, 2)) - cross.transpose() * solved;
+    const double weakest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(centre).eigenvalues()(0);
+    const double s = config.calibration_center_sigma_m;
+    spdlog::debug("pose graph: the alignments know the centre to {:.3f} mm at worst",
+                  weakest > 0.0 ? 1e3 / std::sqrt(weakest) : INFINITY);
+    return !(weakest > 1.0 / (s * s));
+}
+
 namespace pose_graph_internal {
 
 // Re-solves with each group of residuals (the ICP edges' three rows, the prior's translations,
@@ -264,7 +291,8 @@ namespace pose_graph_internal {
 // that many microradians), at most config.variance_rounds. The narrow box whose one alignment
 // of little evidence (above) still counted read +0.69 / +0.57 mm after two rounds, +0.03 /
 // +0.04 mm settled.
-Status SolveWeighedByTheData(PoseGraph& graph, const PoseGraphConfig& config) {
+Status SolveWeighedByTheData(PoseGraph& graph, const PoseGraphConfig& config,
+                             PoseGraphConfig* weighed_out) {
     if (graph.poses.size() < 2) return OkStatus();
     PoseGraphConfig weighed = config;
     Redundancy held{};
@@ -297,6 +325,7 @@ Status SolveWeighedByTheData(PoseGraph& graph, const PoseGraphConfig& config) {
     }
     spdlog::debug("pose graph: weighed by the data in {} rounds",
                   std::min(round + 1, config.variance_rounds));
+    if (weighed_out != nullptr) *weighed_out = weighed;
     return OkStatus();
 }
 

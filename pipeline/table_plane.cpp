@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <set>
 #include <utility>
 
 #include "pipeline/median.h"
@@ -154,6 +155,36 @@ RoundingEvidence TableRounding(const std::vector<std::vector<Eigen::Vector3d>>& 
     return out;
 }
 
+// Readings of a wall that meets the table within the trimming band's height are kept by the
+// trimmed fit as table and, lying only above it, lift the plane (heights read short). Where an
+// object stands, its wall rises straight above its foot: a candidate within two sampling steps
+// (of its own depth, across the table) of a reading above the search band is left out, wall
+// foot and the table hard against it alike. An object no taller than the band is not seen so.
+std::vector<Eigen::Vector3d> WithoutFoot(std::vector<Eigen::Vector3d> pts,
+                                         const std::vector<Eigen::Vector2d>& standing,
+                                         std::vector<double> depths, const CameraIntrinsics& camera,
+                                         int stride) {
+    if (standing.empty() || pts.empty()) return pts;
+    const double cell = 2.0 * stride * Median(std::move(depths)) / camera.fx;
+    const auto key = [cell](const Eigen::Vector2d& xy) {
+        return std::make_pair(static_cast<long>(std::floor(xy.x() / cell)),
+                              static_cast<long>(std::floor(xy.y() / cell)));
+    };
+    std::set<std::pair<long, long>> cells;
+    for (const Eigen::Vector2d& xy : standing) cells.insert(key(xy));
+    std::vector<Eigen::Vector3d> kept;
+    kept.reserve(pts.size());
+    for (const Eigen::Vector3d& p : pts) {
+        const auto [ix, iy] = key(p.head<2>());
+        bool near = false;
+        for (long dx = -1; dx <= 1 && !near; ++dx) {
+            for (long dy = -1; dy <= 1 && !near; ++dy) near = cells.count({ix + dx, iy + dy}) > 0;
+        }
+        if (!near) kept.push_back(p);
+    }
+    return kept;
+}
+
 }  // namespace
 
 Status TablePlaneConfig::Validate() const {
@@ -187,14 +218,20 @@ std::vector<Eigen::Vector3d> TableCandidates(const DepthMap& depth, const Camera
                                              const TablePlaneConfig& config) {
     const Eigen::Isometry3d recorded = calibration.CameraToTable();
     std::vector<Eigen::Vector3d> pts;
+    std::vector<Eigen::Vector2d> standing;
+    std::vector<double> depths;
     for (const Eigen::Vector3f& pc :
          BackProjectDepth(depth, camera, calibration, config.pixel_stride)) {
         const Eigen::Vector3d p = recorded * pc.cast<double>();
-        if (std::abs(p.z()) < config.search_band_m && p.head<2>().norm() < config.fit_radius_m) {
+        const double r = p.head<2>().norm();
+        if (std::abs(p.z()) < config.search_band_m && r < config.fit_radius_m) {
             pts.push_back(p);
+            depths.push_back(pc.z());
+        } else if (p.z() >= config.search_band_m && r < config.fit_radius_m + 0.05) {
+            standing.push_back(p.head<2>());
         }
     }
-    return pts;
+    return WithoutFoot(std::move(pts), standing, depths, camera, config.pixel_stride);
 }
 
 Result<TablePlaneFit> FitTablePlane(const std::vector<DepthMap>& depths,

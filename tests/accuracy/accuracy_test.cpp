@@ -16,6 +16,7 @@
 #include <thread>
 #include <vector>
 
+#include "drivers/sim/synthetic_station.h"
 #include "pipeline/student_t.h"
 #include "tests/support/run_command.h"
 #include "tests/support/temp_dir.h"
@@ -102,7 +103,15 @@ Outcome RunCase(const json& c) {
         o.reason = synth.err;
         return o;
     }
-    const auto r = test::RunBoxd({"measure", "--session", session});
+    // The station's config says how far its calibration placed the table's centre from the
+    // truth, as a station's does (config/sim.yaml for the simulated one): the rendering's error.
+    const std::string config = (dir / "station.yaml").string();
+    std::ofstream(config) << "measurement:\n  calibration_center_sigma_m: "
+                          << std::max(c.value("calib_center_error_m",
+                                              SyntheticStationConfig{}.calib_center_error_m),
+                                      1e-4)
+                          << "\n";
+    const auto r = test::RunBoxd({"measure", "--session", session, "--config", config});
     json j;
     try {
         j = json::parse(r.out);
