@@ -39,7 +39,7 @@ import subprocess
 import sys
 import tempfile
 
-from early_stop_study import HERE, KEYS, errors_mm
+from early_stop_study import HERE, KEYS, errors_mm, station_config
 
 DISC_RADIUS_M = 0.4  # the synthetic turntable's disc
 
@@ -140,7 +140,8 @@ def run_case(boxd, case):
                                capture_output=True, text=True)
         if synth.returncode != 0:
             return {**case, "status": "synth failed", "reason": synth.stderr.strip()}
-        measured = subprocess.run([boxd, "measure", "--session", session],
+        measured = subprocess.run([boxd, "measure", "--session", session,
+                                   *station_config(case, tmp)],
                                   capture_output=True, text=True)
         try:
             result = json.loads(measured.stdout)

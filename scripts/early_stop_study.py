@@ -22,6 +22,20 @@ FLAT_FACES = 2.5  # kFlatFaces
 KEYS = ("length_m", "width_m", "height_m")
 
 
+def station_config(case, directory):
+    """`boxd measure` options for the config of the station that rendered `case`: how far its
+    recorded calibration placed the table's centre, as a station's config says it. The default
+    simulated station's is config/sim.yaml; a case with its own calib_center_error_m gets a file
+    of its own in `directory`."""
+    if "calib_center_error_m" not in case:
+        return ["--config", os.path.join(HERE, "..", "config", "sim.yaml")]
+    path = os.path.join(directory, "station.yaml")
+    with open(path, "w", encoding="utf-8") as f:
+        sigma = max(case["calib_center_error_m"], 1e-4)
+        f.write(f"measurement:\n  calibration_center_sigma_m: {sigma}\n")
+    return ["--config", path]
+
+
 def errors_mm(result, truth):
     """Each dimension's error against `truth` in mm, rounded to the nanometre: the dimension and
     the truth are written to the hundredth of a millimetre, and their difference in doubles may
@@ -69,7 +83,8 @@ def main():
                 out = os.path.join(tmp, case["name"])
                 subprocess.run([args.boxd, *synth_args(case, out, COVERAGE_18[:n])],
                                capture_output=True, check=True)
-                r = json.loads(subprocess.run([args.boxd, "measure", "--session", out],
+                r = json.loads(subprocess.run([args.boxd, "measure", "--session", out,
+                                               *station_config(case, tmp)],
                                               capture_output=True, text=True).stdout)
                 if r["status"] != "ok":
                     continue

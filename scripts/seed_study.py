@@ -23,7 +23,7 @@ import subprocess
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
 
-from early_stop_study import HERE, KEYS, errors_mm, synth_args
+from early_stop_study import HERE, KEYS, errors_mm, station_config, synth_args
 
 SPLIT = re.compile(r"uncertainty: faces ([\d.]+) ([\d.]+) ([\d.]+) mm, registration ([\d.]+) "
                    r"([\d.]+) mm, table ([\d.]+) mm")
@@ -42,8 +42,8 @@ def measure(boxd, case, seed, tmp, split):
     subprocess.run([boxd, *synth_args(dict(case, seed=seed), out, case_angles(case))],
                    capture_output=True, check=True)
     env = dict(os.environ, BOXD_LOG_LEVEL="debug") if split else None
-    run = subprocess.run([boxd, "measure", "--session", out], capture_output=True, text=True,
-                         env=env)
+    run = subprocess.run([boxd, "measure", "--session", out, *station_config(case, out)],
+                         capture_output=True, text=True, env=env)
     r = json.loads(run.stdout)
     if r["status"] != "ok":
         return seed, None, None, r.get("reason", {}).get("code")
