@@ -134,9 +134,9 @@ TEST(CheckFusedFit, ThinCloudFitErrorSmallObjectMovedViewAndRoughFaces) {
               ErrorCode::kRegistrationFailed);
 }
 
-// Appends the sides and the top of the block [x0, x1] x [y0, y1] x [0, h], every 5 mm.
-void AddBlock(FusedCloud& cloud, double x0, double x1, double y0, double y1, double h) {
-    const double step = 0.005;
+// Appends the sides and the top of the block [x0, x1] x [y0, y1] x [0, h], every `step`.
+void AddBlock(FusedCloud& cloud, double x0, double x1, double y0, double y1, double h,
+              double step = 0.005) {
     auto put = [&cloud](double x, double y, double z) {
         cloud.points.emplace_back(static_cast<float>(x), static_cast<float>(y),
                                   static_cast<float>(z));
@@ -200,6 +200,35 @@ TEST(CheckSingleObject, ASpeckBelowTheMinimumShareIsNotAnObject) {
     auto why = CheckSingleObject(cloud, strict);
     ASSERT_TRUE(why.has_value());
     EXPECT_EQ(why->code, ErrorCode::kMultipleObjects);
+}
+
+TEST(CheckSingleObject, LoneReadingsInTheGapDoNotJoinTwoParcels) {
+    // Two parcels 2.5 cm apart, and in the gap a lone reading every other centimetre along it
+    // (mixed pixels at the depth step between them), each touching both footprints' cells. The
+    // parcels are read every 2.5 mm (16 readings a centimetre of top, as a fused cloud holds).
+    FusedCloud cloud;
+    AddBlock(cloud, -0.2, -0.0125, -0.1, 0.1, 0.25, 0.0025);
+    AddBlock(cloud, 0.0125, 0.15, -0.08, 0.08, 0.12, 0.0025);
+    for (double y = -0.075; y <= 0.075; y += 0.02) {
+        cloud.points.emplace_back(-0.005f, static_cast<float>(y), 0.1f);
+        cloud.points.emplace_back(0.005f, static_cast<float>(y), 0.1f);
+        cloud.view.push_back(0);
+        cloud.view.push_back(0);
+    }
+    auto why = CheckSingleObject(cloud, RefusalConfig{});
+    ASSERT_TRUE(why.has_value());
+    EXPECT_EQ(why->code, ErrorCode::kMultipleObjects);
+
+    // A sparse top is still one surface: a reading a cell, the rim's cells as thin as the
+    // footprint's median, none of them dropped.
+    FusedCloud sparse;
+    for (int i = -15; i < 15; ++i) {
+        for (int j = -10; j < 10; ++j) {  // at the cells' centres
+            sparse.points.emplace_back(0.01f * (i + 0.5f), 0.01f * (j + 0.5f), 0.2f);
+            sparse.view.push_back(0);
+        }
+    }
+    EXPECT_FALSE(CheckSingleObject(sparse, RefusalConfig{}).has_value());
 }
 
 EnclosingCuboid Cuboid(double l, double w, double h, bool cuboid) {
