@@ -389,14 +389,13 @@ TEST(FitEnclosingCuboid, ThinCloudIsInsufficientDataWithoutABox) {
         ErrorCode::kInsufficientData);
 }
 
-TEST(FitEnclosingCuboid, OneViewAssumesACuboidFromTheTopsEdges) {
-    // One view of a 0.40 x 0.30 x 0.25 m box turned by 25 degrees: its top read every 2 mm (a
-    // camera's pixels at about 1 m) with 1.5 mm noise, and the side it faces. The footprint is
-    // the top's extent: known to within a cell of the readings' grid (a few mm), so 5 mm.
+// One view of an l x w x h box turned by 25 degrees: its top read every 2 mm (a camera's pixels
+// at about 1 m) with kSigma noise, and the side it faces, standing `out` beyond the top's edge
+// from 5 cm below the top down (0: a box).
+FusedCloud OneViewOfABox(double l, double w, double h, double out = 0.0) {
     std::mt19937 rng(7);
     std::normal_distribution<double> noise(0.0, kSigma);
-    const double l = 0.40, w = 0.30, h = 0.25, yaw = 25.0 * M_PI / 180.0;
-    const Eigen::Rotation2Dd turn(yaw);
+    const Eigen::Rotation2Dd turn(25.0 * M_PI / 180.0);
     FusedCloud cloud;
     auto put = [&](double u, double v, double z) {
         const Eigen::Vector2d xy = turn * Eigen::Vector2d(u, v);
@@ -407,10 +406,24 @@ TEST(FitEnclosingCuboid, OneViewAssumesACuboidFromTheTopsEdges) {
         for (double v = -w / 2 + 0.001; v < w / 2; v += 0.002) put(u, v, h + noise(rng));
     }
     for (double u = -l / 2 + 0.001; u < l / 2; u += 0.002) {
-        for (double z = 0.013; z < h; z += 0.002) put(u, -w / 2 + noise(rng), z);
+        for (double z = 0.013; z < h; z += 0.002) {
+            put(u, -w / 2 - (z < h - 0.05 ? out : 0.0) + noise(rng), z);
+        }
     }
-    const auto c = FitEnclosingCuboid(cloud, FitFootprintBox(cloud.points, BoxFitConfig{}), 1, 0.0,
-                                      kSigma, kOverhead, EnvelopeConfig{});
+    return cloud;
+}
+
+Result<EnclosingCuboid> OneViewCuboid(const FusedCloud& cloud) {
+    return FitEnclosingCuboid(cloud, FitFootprintBox(cloud.points, BoxFitConfig{}), 1, 0.0, kSigma,
+                              kOverhead, EnvelopeConfig{});
+}
+
+TEST(FitEnclosingCuboid, OneViewAssumesACuboidFromTheTopsEdges) {
+    // One view of a 0.40 x 0.30 x 0.25 m box. The footprint is the top's extent: known to within
+    // a cell of the readings' grid (a few mm), so 5 mm.
+    const double l = 0.40, w = 0.30, h = 0.25;
+    const FusedCloud cloud = OneViewOfABox(l, w, h);
+    const auto c = OneViewCuboid(cloud);
     ASSERT_TRUE(c.ok()) << c.error().message;
     EXPECT_TRUE(c->assumed);
     EXPECT_TRUE(c->cuboid);
@@ -430,9 +443,32 @@ TEST(FitEnclosingCuboid, OneViewAssumesACuboidFromTheTopsEdges) {
         }
     }
     // (Its highest readings are the wall's upper strip: a vertical surface, not a top.)
-    test::ExpectError(FitEnclosingCuboid(side, FitFootprintBox(side.points, BoxFitConfig{}), 1, 0.0,
-                                         kSigma, kOverhead, EnvelopeConfig{}),
-                      ErrorCode::kInsufficientData);
+    test::ExpectError(OneViewCuboid(side), ErrorCode::kInsufficientData);
+}
+
+TEST(FitEnclosingCuboid, OneViewOfNoBoxIsRefused) {
+    // The side it shows stands 3 cm outside the top's edge below the top (a bag, a tube lying,
+    // a lower step): the cuboid assumption is contradicted by what the view sees.
+    const auto bag = OneViewCuboid(OneViewOfABox(0.40, 0.30, 0.25, 0.03));
+    test::ExpectError(bag, ErrorCode::kInsufficientData);
+    EXPECT_NE(bag.error().message.find("outside its top's outline"), std::string::npos);
+    // Within the edges' bound (a bulge of 2 mm), the view cannot tell and measures.
+    EXPECT_TRUE(OneViewCuboid(OneViewOfABox(0.40, 0.30, 0.25, 0.002)).ok());
+
+    // Twenty readings 5 cm above the top (a flap seen edge-on): something stands higher than
+    // the top the view reads.
+    FusedCloud flap = OneViewOfABox(0.40, 0.30, 0.25);
+    for (int i = 0; i < 20; ++i) {
+        flap.points.emplace_back(0.01f * static_cast<float>(i) - 0.1f, 0.0f, 0.30f);
+        flap.view.push_back(0);
+    }
+    const auto above = OneViewCuboid(flap);
+    test::ExpectError(above, ErrorCode::kInsufficientData);
+    EXPECT_NE(above.error().message.find("above its top"), std::string::npos);
+    // Three such readings are within what a stray may leave.
+    flap.points.resize(flap.points.size() - 17);
+    flap.view.resize(flap.points.size());
+    EXPECT_TRUE(OneViewCuboid(flap).ok());
 }
 
 TEST(EnvelopeConfig, ValidateNamesTheField) {
