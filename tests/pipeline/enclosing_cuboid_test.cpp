@@ -471,6 +471,53 @@ TEST(FitEnclosingCuboid, OneViewOfNoBoxIsRefused) {
     EXPECT_TRUE(OneViewCuboid(flap).ok());
 }
 
+TEST(FitEnclosingCuboid, OneViewOfATubeIsRefusedByItsCurvedSide) {
+    // A standing tube of 8 cm radius, 25 cm tall: its top disc read every 2 mm and the half of
+    // its side that faces the camera (towards -y). The disc's square would be right; but where
+    // its far side ends the view cannot tell a tube from anything else, and its side is curved.
+    std::mt19937 rng(11);
+    std::normal_distribution<double> noise(0.0, kSigma);
+    const double r = 0.08, h = 0.25;
+    FusedCloud tube;
+    auto put = [&](double x, double y, double z) {
+        tube.points.emplace_back(x, y, z);
+        tube.view.push_back(0);
+    };
+    for (double x = -r; x < r; x += 0.002) {
+        for (double y = -r; y < r; y += 0.002) {
+            if (x * x + y * y < r * r) put(x, y, h + noise(rng));
+        }
+    }
+    for (double a = -M_PI; a < 0.0; a += 0.002 / r) {
+        for (double z = 0.013; z < h; z += 0.002) {
+            const double out = r + noise(rng);
+            put(out * std::cos(a), out * std::sin(a), z);
+        }
+    }
+    const auto c = OneViewCuboid(tube);
+    test::ExpectError(c, ErrorCode::kInsufficientData);
+    EXPECT_NE(c.error().message.find("curved"), std::string::npos) << c.error().message;
+}
+
+TEST(FitEnclosingCuboid, OneViewsHeightBoundCarriesAStrapOverTheTop) {
+    // A 3 mm strap 3 cm wide across the top: the height is the top's median, and its bound
+    // reaches the strap.
+    FusedCloud box = OneViewOfABox(0.40, 0.30, 0.25);
+    const auto plain = OneViewCuboid(box);
+    ASSERT_TRUE(plain.ok()) << plain.error().message;
+    const Eigen::Rotation2Dd turn(25.0 * M_PI / 180.0);
+    for (Eigen::Vector3f& p : box.points) {
+        const Eigen::Vector2d uv = turn.inverse() * Eigen::Vector2d(p.x(), p.y());
+        if (p.z() > 0.24f && std::abs(uv.x()) < 0.015) p.z() += 0.003f;
+    }
+    const auto strapped = OneViewCuboid(box);
+    ASSERT_TRUE(strapped.ok()) << strapped.error().message;
+    // The plain top's bound is its readings' spacing; the strapped one's reaches the strap's
+    // top, which the plain one's does not.
+    EXPECT_LT(kNormal95 * plain->sigma_m[2], 0.253 - strapped->height_m);
+    EXPECT_GT(kNormal95 * strapped->sigma_m[2], 0.253 - strapped->height_m);
+}
+
 TEST(EnvelopeConfig, ValidateNamesTheField) {
     EXPECT_TRUE(EnvelopeConfig{}.Validate().ok());
     auto expect_field = [](const EnvelopeConfig& c, const std::string& field) {
