@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "pipeline/median.h"
 #include "pipeline/student_t.h"
 #include "pipeline/surface_cells.h"
 
@@ -45,13 +46,6 @@ struct SeenSides {
     double widest_spread_m = 0.0;  // the widest 10-90% range of a seen wall's readings
 };
 
-// Returns the 100 p-th percentile of `v` (sorted in place), or NaN when it is empty.
-double Percentile(std::vector<double>& v, double p) {
-    if (v.empty()) return NAN;
-    std::sort(v.begin(), v.end());
-    return v[static_cast<std::size_t>(p * static_cast<double>(v.size() - 1))];
-}
-
 // How far the top's upper level stands above its median: the 98th percentile of its 1 cm cells'
 // median heights over their median. A strap over the top is such a level, a few per cent of the
 // cells 1-3 mm up; a flat top's cells scatter by their readings' noise over their count.
@@ -65,12 +59,12 @@ double UpperLevel(const std::vector<cv::Point2f>& xy, const std::vector<double>&
     std::vector<double> medians;
     for (auto& [key, heights] : cells) {
         if (static_cast<int>(heights.size()) >= kTopCellReadings) {
-            medians.push_back(Percentile(heights, 0.5));
+            medians.push_back(Quantile(heights, 0.5));
         }
     }
     if (medians.size() < 2) return 0.0;
-    const double upper = Percentile(medians, 0.98);
-    return upper - Percentile(medians, 0.5);
+    const double upper = Quantile(medians, 0.98);
+    return upper - Quantile(medians, 0.5);
 }
 
 SeenSides ReadSeenSides(const FusedCloud& cloud, const EnclosingCuboid& c, double wall_below_m,
@@ -98,15 +92,15 @@ SeenSides ReadSeenSides(const FusedCloud& cloud, const EnclosingCuboid& c, doubl
             ++out.hidden[side / 2];
             continue;
         }
-        out.widest_spread_m = std::max(out.widest_spread_m,
-                                       Percentile(wall[side], 0.9) - Percentile(wall[side], 0.1));
+        out.widest_spread_m =
+            std::max(out.widest_spread_m, Quantile(wall[side], 0.9) - Quantile(wall[side], 0.1));
         double outer = -INFINITY;
         for (auto& [slice, excess] : slices[side]) {
             if (static_cast<int>(excess.size()) >= kTopCellReadings) {
-                outer = std::max(outer, Percentile(excess, 0.5));
+                outer = std::max(outer, Quantile(excess, 0.5));
             }
         }
-        const double flat_edge = Percentile(flat[side], 0.98);
+        const double flat_edge = Quantile(flat[side], 0.98);
         if (std::isfinite(flat_edge) && std::isfinite(outer)) {
             out.reach_m = std::max(out.reach_m, outer - flat_edge);
         }
