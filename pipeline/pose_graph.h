@@ -101,7 +101,8 @@ struct PoseGraphReport {
     double max_edge_displacement_m = 0.0;      // largest residual among the kept edges
     double max_model_yaw_deviation_rad = 0.0;  // registered poses vs the turntable model
     double max_model_translation_deviation_m = 0.0;
-    int unconstrained_nodes = 0;  // nodes without any kept edge
+    int unconstrained_nodes = 0;     // nodes without any kept edge ...
+    std::vector<int> unconstrained;  // ... which they are
 };
 
 // Whether the alignments and the turntable prior of `graph`, without the edges' slides, at its

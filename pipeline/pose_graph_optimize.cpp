@@ -86,7 +86,10 @@ Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfi
             std::max(report.max_edge_displacement_m, EdgeDisplacement(graph, e));
     }
     for (std::size_t k = 0; k < graph.poses.size(); ++k) {
-        if (graph.poses.size() > 1 && degree[k] == 0) ++report.unconstrained_nodes;
+        if (graph.poses.size() > 1 && degree[k] == 0) {
+            ++report.unconstrained_nodes;
+            report.unconstrained.push_back(static_cast<int>(k));
+        }
         const Se2 model = Se2::RotationAbout(graph.commanded_yaw[k], graph.center_offset);
         const Eigen::Vector3d d = Se2Difference(graph.poses[k], model);
         report.max_model_yaw_deviation_rad =

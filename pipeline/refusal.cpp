@@ -123,14 +123,24 @@ std::optional<MeasurementReason> CheckRegisteredViews(const RegisteredViews& reg
                                  report.rejected_edges, edges));
     }
     // Views too far apart to share any surface (two or three poses) cannot be aligned, and are
-    // not: their poses rest on the turntable model of the calibrated station.
-    const bool model_only = registered.edges.attempted == 0;
-    if (!model_only && (report.active_edges == 0 ||
-                        report.unconstrained_nodes > refuse.max_unconstrained_fraction * poses)) {
+    // not: their poses rest on the turntable model of the calibrated station. So do views whose
+    // alignments found no side in common with their neighbours, their tops matching (each sees
+    // sides the others do not: four poses a quarter turn apart round a box that faces one of
+    // them), and their bounds carry the calibration's. A view left without an alignment
+    // although one tested it (a side in common, or a top elsewhere) is unregistered: the
+    // alignments disagreed.
+    const std::vector<int>& tested = registered.edges.tested_views;
+    int unregistered = 0;
+    for (int k : report.unconstrained) {
+        unregistered += std::binary_search(tested.begin(), tested.end(), k) ? 1 : 0;
+    }
+    const bool model_only = report.active_edges == 0 && unregistered == 0;
+    if (!model_only &&
+        (report.active_edges == 0 || unregistered > refuse.max_unconstrained_fraction * poses)) {
         return MeasurementReason{
             ErrorCode::kRegistrationFailed,
-            fmt::format("too few views could be registered ({} of {} unregistered)",
-                        report.unconstrained_nodes, poses)};
+            fmt::format("too few views could be registered ({} of {} unregistered)", unregistered,
+                        poses)};
     }
     if (registered.edges.mean_rmse_m > refuse.max_registration_rmse_m) {
         return MeasurementReason{ErrorCode::kRegistrationFailed,

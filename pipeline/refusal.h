@@ -50,7 +50,9 @@ std::optional<MeasurementReason> CheckObjectViews(const ObjectViews& views,
 // Registered views (of `poses` views; a single view is not judged): OBJECT_MOVED when the
 // registered poses leave the turntable model or too many alignments disagree with the rest (the
 // views show the object in two places), REGISTRATION_FAILED when too few views are registered
-// or the views do not align.
+// or the views do not align. A view whose alignments found no side in common with any view it
+// was paired with, their tops matching (EdgeStats::tested_views), rests on the turntable model,
+// as views too far apart to pair do, and is not counted unregistered.
 std::optional<MeasurementReason> CheckRegisteredViews(const RegisteredViews& registered, int poses,
                                                       const RefusalConfig& refuse);
 

@@ -175,16 +175,23 @@ std::vector<PoseEdge> AcceptedEdges(const std::vector<PairAlignment>& alignments
             r.correspondences, r.rmse * 1000.0, r.transform.x * 1000.0, r.transform.y * 1000.0,
             r.transform.yaw * 180.0 / M_PI);
         // An alignment with too few upright correspondences never left its start: its
-        // "measurement" would only repeat the turntable model, as if confirming it.
-        if (r.solved < config.fine.min_correspondences || r.fitness < config.min_fitness ||
-            r.rmse > config.max_rmse_m) {
-            continue;
+        // "measurement" would only repeat the turntable model, as if confirming it. Where the
+        // rest (the top) matched, its views share no side; where nothing did, they disagree.
+        const bool matched = r.fitness >= config.min_fitness && r.rmse <= config.max_rmse_m;
+        const bool sides = r.solved >= config.fine.min_correspondences;
+        if (sides || !matched) {
+            st.tested_views.push_back(a.edge.from);
+            st.tested_views.push_back(a.edge.to);
         }
+        if (!sides || !matched) continue;
         ++st.accepted;
         rmse_sum += r.rmse;
         accepted.push_back(a.edge);
     }
     st.mean_rmse_m = st.accepted > 0 ? rmse_sum / st.accepted : 0.0;
+    std::sort(st.tested_views.begin(), st.tested_views.end());
+    st.tested_views.erase(std::unique(st.tested_views.begin(), st.tested_views.end()),
+                          st.tested_views.end());
     if (stats) *stats = st;
     return accepted;
 }

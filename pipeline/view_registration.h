@@ -56,6 +56,11 @@ struct EdgeStats {
     int attempted = 0;
     int accepted = 0;
     double mean_rmse_m = 0.0;  // over accepted edges
+    // The views (sorted, once each) of the alignments that tested them against a neighbour,
+    // accepted or not: that found a side in common, or found the view's top disagreeing with
+    // its neighbour's (the object elsewhere). A view in none of them saw other sides than its
+    // neighbours, its top where theirs is.
+    std::vector<int> tested_views;
 };
 
 // Returns node k's initial pose: the rotation by -angle_k (relative to pose 0) about the axis,

@@ -88,15 +88,39 @@ TEST(CheckRegisteredViews, MovedObjectUnregisteredViewsAndPoorAlignment) {
     EXPECT_EQ(CheckRegisteredViews(Registered(31, 9, 0.001), 18, refuse)->code,
               ErrorCode::kObjectMoved);
 
+    // Five of 18 views (> 25%) left without an alignment although one tested each (a side in
+    // common, or a top elsewhere): the alignments disagreed there.
     r = Registered(30, 0, 0.001);
-    r.graph.unconstrained_nodes = 5;  // > 25% of 18
+    r.graph.unconstrained = {2, 5, 8, 11, 14};
+    r.graph.unconstrained_nodes = 5;
+    for (int k = 0; k < 18; ++k) r.edges.tested_views.push_back(k);
     EXPECT_EQ(CheckRegisteredViews(r, 18, refuse)->code, ErrorCode::kRegistrationFailed);
+    // The same five sharing no surface with the views they were paired with (each saw sides the
+    // others did not) rest on the turntable model: not refused.
+    r.edges.tested_views = {0, 1, 3, 4, 6, 7, 9, 10, 12, 13, 15, 16, 17};
+    EXPECT_FALSE(CheckRegisteredViews(r, 18, refuse).has_value());
+
+    // Tried, none held, though they tested the views: refused.
     RegisteredViews none_aligned = Registered(0, 0, 0.0);
-    none_aligned.edges.attempted = 30;  // tried, none held
-    EXPECT_EQ(CheckRegisteredViews(none_aligned, 18, refuse)->code, ErrorCode::kRegistrationFailed);
-    // Views too far apart to share a surface (two or three poses) are not aligned at all: they
-    // rest on the turntable model and are not refused for it.
+    none_aligned.edges.attempted = 30;
+    for (int k = 0; k < 18; ++k) {
+        none_aligned.graph.unconstrained.push_back(k);
+        none_aligned.edges.tested_views.push_back(k);
+    }
+    none_aligned.graph.unconstrained_nodes = 18;
+    auto failed = CheckRegisteredViews(none_aligned, 18, refuse);
+    ASSERT_TRUE(failed.has_value());
+    EXPECT_EQ(failed->code, ErrorCode::kRegistrationFailed);
+    EXPECT_NE(failed->message.find("18 of 18 unregistered"), std::string::npos) << failed->message;
+    // Views too far apart to share a surface (two or three poses) are not aligned at all, and
+    // four views a quarter turn apart that each see other sides find none in common: either way
+    // they rest on the turntable model and are not refused for it.
     EXPECT_FALSE(CheckRegisteredViews(Registered(0, 0, 0.0), 3, refuse).has_value());
+    RegisteredViews apart = Registered(0, 0, 0.0);
+    apart.edges.attempted = 4;
+    apart.graph.unconstrained = {0, 1, 2, 3};
+    apart.graph.unconstrained_nodes = 4;
+    EXPECT_FALSE(CheckRegisteredViews(apart, 4, refuse).has_value());
 
     why = CheckRegisteredViews(Registered(36, 0, refuse.max_registration_rmse_m * 1.5), 18, refuse);
     ASSERT_TRUE(why.has_value());

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <set>
@@ -46,7 +47,7 @@ protected:
         for (int k = 0; k < kViews; ++k) {
             views_->push_back(BuildRegistrationClouds(kScene.View(kScene.TrueAngle(k), 100 + k),
                                                       config.coarse_cloud, config.fine_cloud,
-                                    kScene.Camera()));
+                                                      kScene.Camera()));
             angles_->push_back(kScene.Commanded(k));
         }
     }
@@ -183,8 +184,8 @@ TEST_F(RegisterViewPairsTest, PairThatCannotAlignIsLeftOut) {
     const RegistrationConfig config;
     Points moved = kScene.View(kScene.TrueAngle(3), 103);
     for (Eigen::Vector3f& p : moved) p.x() += 0.5f;
-    views[3] = BuildRegistrationClouds(moved, config.coarse_cloud, config.fine_cloud,
-                                    kScene.Camera());
+    views[3] =
+        BuildRegistrationClouds(moved, config.coarse_cloud, config.fine_cloud, kScene.Camera());
     EdgeStats stats;
     const std::vector<PoseEdge> edges = RegisterViewPairs(views, *angles_, config, &stats);
     EXPECT_EQ(stats.attempted, 16);
@@ -193,6 +194,9 @@ TEST_F(RegisterViewPairsTest, PairThatCannotAlignIsLeftOut) {
         EXPECT_NE(e.from, 3);
         EXPECT_NE(e.to, 3);
     }
+    // Nothing of view 3 matched its neighbours', its top neither: the alignments tested it and
+    // found it elsewhere (an unregistered view, not one resting on the turntable model).
+    EXPECT_TRUE(std::binary_search(stats.tested_views.begin(), stats.tested_views.end(), 3));
 }
 
 TEST_F(RegisterViewPairsTest, PairSharingOnlyTheTopIsLeftOut) {
@@ -205,8 +209,8 @@ TEST_F(RegisterViewPairsTest, PairSharingOnlyTheTopIsLeftOut) {
     for (const Eigen::Vector3f& p : kScene.View(kScene.TrueAngle(3), 103)) {
         if (p.z() > 0.1495f) top.push_back(p);
     }
-    views[3] = BuildRegistrationClouds(top, config.coarse_cloud, config.fine_cloud,
-                                    kScene.Camera());
+    views[3] =
+        BuildRegistrationClouds(top, config.coarse_cloud, config.fine_cloud, kScene.Camera());
     EdgeStats stats;
     const std::vector<PoseEdge> edges = RegisterViewPairs(views, *angles_, config, &stats);
     EXPECT_EQ(stats.attempted, 16);
@@ -215,6 +219,8 @@ TEST_F(RegisterViewPairsTest, PairSharingOnlyTheTopIsLeftOut) {
         EXPECT_NE(e.from, 3);
         EXPECT_NE(e.to, 3);
     }
+    // Its top matched theirs; no side was in common: untested, it rests on the turntable model.
+    EXPECT_FALSE(std::binary_search(stats.tested_views.begin(), stats.tested_views.end(), 3));
 }
 
 }  // namespace
