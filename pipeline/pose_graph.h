@@ -101,8 +101,7 @@ struct PoseGraphReport {
     double max_edge_displacement_m = 0.0;      // largest residual among the kept edges
     double max_model_yaw_deviation_rad = 0.0;  // registered poses vs the turntable model
     double max_model_translation_deviation_m = 0.0;
-    int unconstrained_nodes = 0;     // nodes without any kept edge ...
-    std::vector<int> unconstrained;  // ... which they are
+    std::vector<int> unconstrained;  // the nodes without any kept edge
 };
 
 // Whether the alignments and the turntable prior of `graph`, without the edges' slides, at its

@@ -87,7 +87,6 @@ Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfi
     }
     for (std::size_t k = 0; k < graph.poses.size(); ++k) {
         if (graph.poses.size() > 1 && degree[k] == 0) {
-            ++report.unconstrained_nodes;
             report.unconstrained.push_back(static_cast<int>(k));
         }
         const Se2 model = Se2::RotationAbout(graph.commanded_yaw[k], graph.center_offset);

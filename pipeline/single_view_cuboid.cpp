@@ -209,12 +209,13 @@ Result<EnclosingCuboid> SingleViewCuboid(const FusedCloud& cloud, double noise_s
     const Eigen::Vector2d along = c.length_axis, across(-along.y(), along.x());
     const double reach_l = c.length_m / 2.0 + kNormal95 * c.sigma_m[0];
     const double reach_w = c.width_m / 2.0 + kNormal95 * c.sigma_m[1];
-    std::size_t readings = 0, outside = 0;
+    std::size_t readings = 0, outside = 0, above = 0;  // above: the check after this one
     for (const Eigen::Vector3f& p : cloud.points) {
         if (p.z() < config.min_z_m) continue;
         const Eigen::Vector2d d = Eigen::Vector2d(p.x(), p.y()) - c.center_m;
         ++readings;
         outside += std::abs(d.dot(along)) > reach_l || std::abs(d.dot(across)) > reach_w;
+        above += p.z() > top + band;
     }
     if (static_cast<double>(outside) > kStrayShare * static_cast<double>(readings)) {
         return Error{
@@ -228,8 +229,6 @@ Result<EnclosingCuboid> SingleViewCuboid(const FusedCloud& cloud, double noise_s
     // `expected` of them; a few more are a part standing higher (a flap opened towards the
     // camera, seen edge-on: 6 to 111 readings of 47,000 on one Kinect view from 1 m; boxes and
     // tubes: none).
-    std::size_t above = 0;
-    for (const Eigen::Vector3f& p : cloud.points) above += p.z() > top + band;
     const double expected =
         0.5 * std::erfc(band / (noise_sigma * std::sqrt(2.0))) * static_cast<double>(readings);
     if (static_cast<double>(above) > 3.0 + expected + 3.0 * std::sqrt(expected)) {

@@ -92,7 +92,6 @@ TEST(CheckRegisteredViews, MovedObjectUnregisteredViewsAndPoorAlignment) {
     // common, or a top elsewhere): the alignments disagreed there.
     r = Registered(30, 0, 0.001);
     r.graph.unconstrained = {2, 5, 8, 11, 14};
-    r.graph.unconstrained_nodes = 5;
     for (int k = 0; k < 18; ++k) r.edges.tested_views.push_back(k);
     EXPECT_EQ(CheckRegisteredViews(r, 18, refuse)->code, ErrorCode::kRegistrationFailed);
     // The same five sharing no surface with the views they were paired with (each saw sides the
@@ -107,7 +106,6 @@ TEST(CheckRegisteredViews, MovedObjectUnregisteredViewsAndPoorAlignment) {
         none_aligned.graph.unconstrained.push_back(k);
         none_aligned.edges.tested_views.push_back(k);
     }
-    none_aligned.graph.unconstrained_nodes = 18;
     auto failed = CheckRegisteredViews(none_aligned, 18, refuse);
     ASSERT_TRUE(failed.has_value());
     EXPECT_EQ(failed->code, ErrorCode::kRegistrationFailed);
@@ -119,7 +117,6 @@ TEST(CheckRegisteredViews, MovedObjectUnregisteredViewsAndPoorAlignment) {
     RegisteredViews apart = Registered(0, 0, 0.0);
     apart.edges.attempted = 4;
     apart.graph.unconstrained = {0, 1, 2, 3};
-    apart.graph.unconstrained_nodes = 4;
     EXPECT_FALSE(CheckRegisteredViews(apart, 4, refuse).has_value());
 
     why = CheckRegisteredViews(Registered(36, 0, refuse.max_registration_rmse_m * 1.5), 18, refuse);
