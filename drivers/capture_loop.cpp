@@ -18,17 +18,21 @@ Error ConfigError(const std::string& field, const std::string& what) {
     return Error{ErrorCode::kInvalidInput, "capture." + field + ": " + what};
 }
 
+bool Cancelled(const CaptureCallbacks& cb) {
+    return (cb.cancel && cb.cancel->load()) || (cb.owner_cancel && cb.owner_cancel->load());
+}
+
 // Forwards a cancel flag to the turntable while a capture runs: a move in progress is stopped
 // at once rather than at the next pose. RequestStop only sets an atomic flag in the driver, so
 // calling it from this thread is allowed by the Turntable contract.
 class CancelWatcher {
 public:
-    CancelWatcher(const std::atomic<bool>* cancel, Turntable& turntable) {
-        if (!cancel) return;
-        thread_ = std::thread([this, cancel, &turntable] {
+    CancelWatcher(const CaptureCallbacks& cb, Turntable& turntable) {
+        if (!cb.cancel && !cb.owner_cancel) return;
+        thread_ = std::thread([this, &cb, &turntable] {
             std::unique_lock lock(mutex_);
             while (!done_) {
-                if (cancel->load()) {
+                if (Cancelled(cb)) {
                     turntable.RequestStop();
                     return;
                 }
@@ -52,7 +56,6 @@ private:
     std::thread thread_;
 };
 
-bool Cancelled(const CaptureCallbacks& cb) { return cb.cancel && cb.cancel->load(); }
 
 // Sleeps `ms`, waking early when the capture is cancelled; returns false when cancelled.
 bool SleepUnlessCancelled(int ms, const CaptureCallbacks& cb) {
@@ -179,7 +182,7 @@ Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
     session.direction = station.direction;
 
     turntable.ClearStopRequest();
-    CancelWatcher watcher(callbacks.cancel, turntable);
+    CancelWatcher watcher(callbacks, turntable);
     const auto timeout = std::chrono::milliseconds(config.grab_timeout_ms);
     auto cancelled = [&](int pose) -> Error {
         StopTable(turntable);

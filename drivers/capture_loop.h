@@ -63,9 +63,10 @@ struct CaptureCallbacks {
     // yet moved on), so a caller can process pose k while the table moves to k+1. Runs on the
     // capture thread: hand heavy work to another thread.
     std::function<void(std::size_t index, const SessionPose& pose)> on_pose;
-    // When it becomes true the table is stopped (also mid-move) and the capture returns a
-    // CANCELLED error.
+    // When either becomes true the table is stopped (also mid-move) and the capture returns a
+    // CANCELLED error: the run's own cancel, and its owner's (a station shutting down).
     const std::atomic<bool>* cancel = nullptr;
+    const std::atomic<bool>* owner_cancel = nullptr;
     // Asked after each pose but the last, before the table moves on, with the count of poses
     // so far: true ends the capture there (the session holds those poses).
     std::function<bool(int captured)> stop;

@@ -40,7 +40,8 @@ Result<std::unique_ptr<DepthCamera>> MakeDepthCamera(const CameraConfig& config,
     return std::unique_ptr<DepthCamera>(std::make_unique<ReplayCamera>(*source));
 }
 
-Result<StationDevices> OpenStation(const StationConfig& config) {
+Result<StationDevices> OpenStation(const StationConfig& config,
+                                   const std::atomic<bool>* cancel) {
     StationDevices devices;
     devices.capture = config.capture;
     devices.calibrated = config.calibration.has_value();
@@ -68,7 +69,7 @@ Result<StationDevices> OpenStation(const StationConfig& config) {
                      devices.capture.frames_per_pose);
     } else {
         devices.station.direction = ParseDirection(config.turntable.direction);
-        auto turntable = MakeTurntable(config.turntable);
+        auto turntable = MakeTurntable(config.turntable, cancel);
         if (!turntable) return turntable.error();
         devices.turntable = std::move(turntable).value();
         auto camera =

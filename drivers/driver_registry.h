@@ -5,6 +5,7 @@
 //   turntable.driver: modbus-tcp | modbus-rtu | simulated (MakeTurntable); a replay camera
 //   brings its own replay turntable and the turntable section is not used.
 
+#include <atomic>
 #include <memory>
 
 #include "drivers/depth_camera.h"
@@ -35,8 +36,10 @@ Result<std::unique_ptr<DepthCamera>> MakeDepthCamera(const CameraConfig& config,
                                                      TurntableDirection direction);
 
 // Returns the turntable (connected) and the camera (opened) of `config`, or the first
-// TURNTABLE_ERROR / CAMERA_ERROR / INVALID_SESSION error.
-Result<StationDevices> OpenStation(const StationConfig& config);
+// TURNTABLE_ERROR / CAMERA_ERROR / INVALID_SESSION error. Setting `*cancel` abandons a wait for
+// a device to come up (the simulated drive's launch) with an ABORTED error.
+Result<StationDevices> OpenStation(const StationConfig& config,
+                                   const std::atomic<bool>* cancel = nullptr);
 
 // Returns the direction a `turntable.direction` string names ("cw" or else ccw).
 TurntableDirection ParseDirection(const std::string& direction);

@@ -13,8 +13,10 @@ namespace {
 // ordinary ModbusTurntable over loopback — the same code path as a real drive.
 class SimulatedTurntable : public Turntable {
 public:
-    static Result<std::unique_ptr<Turntable>> Start(const TurntableConfig& config) {
+    static Result<std::unique_ptr<Turntable>> Start(const TurntableConfig& config,
+                                                    const std::atomic<bool>* cancel) {
         SimTurntableLaunch launch;
+        launch.cancel = cancel;
         launch.binary = config.simulator_binary;
         launch.port = config.port;
         // The simulated drive's top speed allows any configured speed; the speed register
@@ -57,9 +59,10 @@ private:
 
 }  // namespace
 
-Result<std::unique_ptr<Turntable>> MakeTurntable(const TurntableConfig& config) {
+Result<std::unique_ptr<Turntable>> MakeTurntable(const TurntableConfig& config,
+                                                 const std::atomic<bool>* cancel) {
     if (auto st = config.Validate(); !st) return st.error();
-    if (config.driver == "simulated") return SimulatedTurntable::Start(config);
+    if (config.driver == "simulated") return SimulatedTurntable::Start(config, cancel);
     auto driver = ModbusTurntable::Open(config);
     if (!driver) return driver.error();
     return std::unique_ptr<Turntable>(std::move(*driver));

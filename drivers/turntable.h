@@ -17,6 +17,7 @@
 // Thread safety: one thread drives a Turntable; only RequestStop() / ClearStopRequest() may be
 // called from another thread (or a signal handler: they only touch an atomic flag).
 
+#include <atomic>
 #include <memory>
 #include <string>
 
@@ -107,7 +108,9 @@ struct TurntableConfig {
 // unknown keys, wrong types and invalid values are errors naming the key).
 Result<TurntableConfig> ParseTurntableConfig(const YAML::Node& node);
 
-// Returns the driver `config.driver` names, connected (not yet homed), or TURNTABLE_ERROR.
-Result<std::unique_ptr<Turntable>> MakeTurntable(const TurntableConfig& config);
+// Returns the driver `config.driver` names, connected (not yet homed), or TURNTABLE_ERROR; ABORTED
+// when `*cancel` is set while the simulated drive is still starting.
+Result<std::unique_ptr<Turntable>> MakeTurntable(const TurntableConfig& config,
+                                                 const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace boxd

@@ -8,6 +8,8 @@
 #   scripts/dev.sh build  build only (into ./build)
 #   scripts/dev.sh sanitize  clang build with ASan + UBSan (./build-sanitize), whole suite
 #   scripts/dev.sh fuzz   the libFuzzer targets, FUZZ_SECONDS (60) each, on tests/fuzz/corpus
+#   scripts/dev.sh tsan   clang build with ThreadSanitizer (./build-tsan): the daemon and the
+#                         tests of the drivers and the service
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -139,12 +141,47 @@ fuzz() {
     done
 }
 
+# ThreadSanitizer: every process (the tests, and the daemons and simulators they start) writes
+# its reports to one folder; any report fails the run, whatever the process's exit code was.
+TSAN_DIR=${TSAN_DIR:-build-tsan}
+TSAN_LABELS='^(drivers|drivers/sim|daemon/service)$'
+# Not threads: packaging and a browser (as in the sanitizer run above).
+TSAN_SKIP='DebianPackage[.]|OperatorPage[.]'
+
+tsan() {
+    local reports="$PWD/$TSAN_DIR/tsan-reports" status=0
+    rm -rf "$reports"
+    mkdir -p "$reports"
+    # Also for the build: listing a test executable's tests runs it.
+    export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:log_path=$reports/report"
+    TSAN_OPTIONS+=":suppressions=$PWD/tests/tsan.supp"
+    CC=clang CXX=clang++ configure "$TSAN_DIR" tsan -DCMAKE_BUILD_TYPE=Release -DBOXD_TSAN=ON
+    local targets=(--target boxd) f
+    for f in tests/drivers/*_test.cpp tests/drivers/sim/*_test.cpp tests/daemon/service/*_test.cpp; do
+        local stem=${f#tests/}
+        stem=${stem%.cpp}
+        targets+=(--target "${stem//\//_}")
+    done
+    cmake --build "$TSAN_DIR" -j "$JOBS" "${targets[@]}" || status=1
+    if [ $status -eq 0 ]; then
+        (cd "$TSAN_DIR" && ctest --output-on-failure -j "$JOBS" -L "$TSAN_LABELS" -E "$TSAN_SKIP") \
+            || status=1
+    fi
+    if compgen -G "$reports/report*" > /dev/null; then
+        echo "dev.sh: ThreadSanitizer reports:" >&2
+        head -n 80 "$reports"/report* >&2
+        status=1
+    fi
+    return $status
+}
+
 case "${1:-}" in
     demo) deps; build boxd; demo ;;
-    test) deps; build; run_tests; sanitize "$SANITIZE_SLOW"; fuzz ;;
+    test) deps; build; run_tests; sanitize "$SANITIZE_SLOW"; tsan; fuzz ;;
     deps) deps ;;
     build) build ;;
     sanitize) deps; sanitize ;;
     fuzz) deps; fuzz ;;
-    *) echo "usage: scripts/dev.sh demo|test|deps|build|sanitize|fuzz" >&2; exit 2 ;;
+    tsan) deps; tsan ;;
+    *) echo "usage: scripts/dev.sh demo|test|deps|build|sanitize|fuzz|tsan" >&2; exit 2 ;;
 esac

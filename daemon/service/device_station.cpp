@@ -3,19 +3,12 @@
 #include <spdlog/spdlog.h>
 
 #include <chrono>
-#include <fstream>
 
-#include "calibration/station_calibrator.h"
-#include "daemon/service/service_json.h"
 #include "pipeline/measure_pipeline.h"
 #include "pipeline/ply_writer.h"
 #include "pipeline/session_io.h"
-#include "pipeline/station_calibration_json.h"
-#include "pipeline/json_text.h"
 
 namespace boxd {
-
-using nlohmann::json;
 
 namespace {
 
@@ -37,62 +30,71 @@ DeviceStation::DeviceStation(DeviceStationConfig config) : config_(std::move(con
     LoadStoredCalibration();
 }
 
-void DeviceStation::LoadStoredCalibration() {
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    if (config_.calibration_file.empty() || !fs::exists(config_.calibration_file, ec)) return;
-    const auto stored_time = fs::last_write_time(config_.calibration_file, ec);
-    if (ec) return;
-    const auto config_time = fs::last_write_time(config_.config_file, ec);
-    if (!ec && config_.station.calibration && config_time > stored_time) {
-        spdlog::info("calibration: {} is newer than {}; using the config's",
-                     config_.config_file.string(), config_.calibration_file.string());
-        return;
-    }
-    std::ifstream in(config_.calibration_file);
-    const json j = json::parse(in, nullptr, false);
-    const std::string file = config_.calibration_file.string();
-    Result<StationCalibration> c =
-        j.is_object() && j.contains("calibration")
-            ? StationCalibrationFromJson(j["calibration"], "calibration")
-            : Result<StationCalibration>(
-                  Error{ErrorCode::kInvalidInput, "not a JSON object with a calibration"});
-    if (!c) {
-        spdlog::error("calibration: ignoring {}: {}", file, c.error().message);
-        return;
-    }
-    config_.station.calibration = *c;
-    calibration_source_ = config_.calibration_file;
-    spdlog::info("calibration: using {} (from POST /v1/calibrate)",
-                 config_.calibration_file.string());
-}
-
-DeviceStation::~DeviceStation() { CloseDevices(); }
+DeviceStation::~DeviceStation() { Shutdown(); }
 
 Status DeviceStation::Open() {
-    CloseDevices();
-    Result<StationDevices> devices = OpenStation(config_.station);
+    std::uint64_t asked_at = 0;
+    {
+        std::lock_guard lock(devices_mutex_);
+        asked_at = opens_finished_;
+    }
+    std::lock_guard life(lifecycle_mutex_);
+    if (stopping_) return Error{ErrorCode::kShuttingDown, "the daemon is stopping"};
+    if (open_) return OkStatus();  // another thread opened them while this one waited
+    {
+        // An open that failed while this caller waited is the answer to its request too (a
+        // success is: open_ above; devices closed since then are opened again).
+        std::lock_guard lock(devices_mutex_);
+        if (opens_finished_ != asked_at && !last_open_) return last_open_;
+    }
+    Status opened = OpenLocked();
+    std::lock_guard lock(devices_mutex_);
+    ++opens_finished_;
+    last_open_ = opened;
+    return opened;
+}
+
+Status DeviceStation::OpenLocked() {
+    CloseLocked();  // the devices of a faulted run go first
+    Result<StationDevices> devices = OpenStation(config_.station, &stopping_);
     if (!devices) {
+        if (stopping_) return Error{ErrorCode::kShuttingDown, "the daemon is stopping"};
         MarkDeviceError(devices.error());
         return devices.error();
     }
-    auto opened = std::make_unique<StationDevices>(std::move(*devices));
+    auto opened = std::make_shared<StationDevices>(std::move(*devices));
+    {
+        std::lock_guard lock(devices_mutex_);
+        opening_ = opened;
+    }
+    // A Shutdown() that came before `opening_` was set could not stop this table: stop it here.
+    if (stopping_) opened->turntable->RequestStop();
     // Homing at start-up finds a faulted or unreachable drive before the first parcel does.
-    if (Status homed = opened->turntable->Home(); !homed) {
+    Status homed = opened->turntable->Home();
+    {
+        std::lock_guard lock(devices_mutex_);
+        opening_.reset();
+    }
+    if (!homed || stopping_) {
+        if (Status s = opened->turntable->Stop(); !s) {
+            spdlog::warn("stopping the turntable after a failed open: {}", s.error().message);
+        }
         opened->camera->Close();
+        if (stopping_) return Error{ErrorCode::kShuttingDown, "the daemon is stopping"};
         MarkDeviceError(homed.error());
         return homed.error();
     }
+    const std::string turntable = opened->turntable->Describe();
+    const std::string camera = opened->camera->Describe();
     {
         std::lock_guard lock(devices_mutex_);
-        turntable_description_ = opened->turntable->Describe();
-        camera_description_ = opened->camera->Describe();
+        turntable_description_ = turntable;
+        camera_description_ = camera;
         device_error_.reset();
         devices_ = std::move(opened);
+        open_ = true;
     }
-    open_ = true;
-    spdlog::info("devices up: turntable {}; camera {}", turntable_description_,
-                 camera_description_);
+    spdlog::info("devices up: turntable {}; camera {}", turntable, camera);
     return OkStatus();
 }
 
@@ -103,8 +105,8 @@ void DeviceStation::MarkDeviceError(const Error& error) {
     open_ = false;
 }
 
-void DeviceStation::CloseDevices() {
-    std::unique_ptr<StationDevices> devices;
+void DeviceStation::CloseLocked() {
+    std::shared_ptr<StationDevices> devices;
     {
         std::lock_guard lock(devices_mutex_);
         devices = std::move(devices_);
@@ -123,17 +125,21 @@ void DeviceStation::CloseDevices() {
 Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms,
                                        std::unique_ptr<PosePreparer>* preparer) {
     capture_ms = 0.0;
-    StationDevices* devices = nullptr;
+    // The capture is the devices' user until it returns: no open or close replaces them.
+    std::lock_guard life(lifecycle_mutex_);
+    std::shared_ptr<StationDevices> devices;
     {
         std::lock_guard lock(devices_mutex_);
-        devices = devices_.get();
+        devices = devices_;
     }
+    if (stopping_) return Error{ErrorCode::kAborted, "the daemon is stopping"};
     if (!devices || !open_) return Error{ErrorCode::kCameraError, "the devices are not open"};
     devices->turntable->ClearStopRequest();
     const int poses = static_cast<int>(devices->capture.Angles().size());
     if (ctx.progress) ctx.progress(JobProgress{"capture", 0, poses});
     CaptureCallbacks callbacks;
     callbacks.cancel = ctx.cancel;
+    callbacks.owner_cancel = &stopping_;  // a Shutdown() that came after the check above
     callbacks.on_progress = [&ctx](int pose, int n) {
         if (ctx.progress) ctx.progress(JobProgress{"capture", pose, n});
     };
@@ -244,45 +250,18 @@ JobOutput DeviceStation::Measure(const JobContext& ctx) {
     return out;
 }
 
-Result<CalibrationRun> DeviceStation::Calibrate(const JobContext& ctx,
-                                                const BoxDimensions& reference) {
-    double capture_ms = 0.0;
-    Result<Session> session = Capture(ctx, capture_ms);
-    if (!session) return session.error();
-    const int poses = static_cast<int>(session->poses.size());
-    if (ctx.progress) ctx.progress(JobProgress{"calibration", poses, poses});
-    Result<CalibrationReport> report = CalibrateStation(*session, reference, CalibrationConfig{});
-    if (!report) return report.error();
-
-    CalibrationRun run{std::move(*report), UtcTimestampNow(), reference};
-    // Durable before it is in force: written to a temporary file, then renamed over the old one.
-    const auto tmp = config_.calibration_file.string() + ".tmp";
-    {
-        std::ofstream file(tmp);
-        file << JsonText(ToJson(run), 2) << "\n";
-        if (!file) return Error{ErrorCode::kStorageError, "cannot write " + tmp};
-    }
-    std::error_code ec;
-    std::filesystem::rename(tmp, config_.calibration_file, ec);
-    if (ec)
-        return Error{ErrorCode::kStorageError, "cannot write " + config_.calibration_file.string()};
-
-    std::lock_guard lock(devices_mutex_);
-    config_.station.calibration = run.report.calibration;
-    calibration_source_ = config_.calibration_file;
-    if (devices_) {
-        devices_->station.calibration = run.report.calibration;
-        devices_->calibrated = true;
-    }
-    return run;
-}
-
 void DeviceStation::RequestStop() {
     std::lock_guard lock(devices_mutex_);
     if (devices_ && devices_->turntable) devices_->turntable->RequestStop();
+    if (opening_ && opening_->turntable) opening_->turntable->RequestStop();
 }
 
-void DeviceStation::Shutdown() { CloseDevices(); }
+void DeviceStation::Shutdown() {
+    stopping_ = true;  // an open in progress gives up at its next step
+    RequestStop();
+    std::lock_guard life(lifecycle_mutex_);
+    CloseLocked();
+}
 
 DeviceHealth DeviceStation::Devices() const {
     std::lock_guard lock(devices_mutex_);
@@ -292,25 +271,6 @@ DeviceHealth DeviceStation::Devices() const {
         DeviceState{config_.station.camera.driver, camera_description_, ok},
         device_error_,
     };
-}
-
-CalibrationInForce DeviceStation::Calibration() const {
-    CalibrationInForce out;
-    std::lock_guard lock(devices_mutex_);
-    out.calibration = config_.station.calibration;
-    if (!out.calibration && devices_ && devices_->calibrated) {
-        out.calibration = devices_->station.calibration;
-    }
-    if (!out.calibration) return out;
-    out.source = calibration_source_;
-    // The calibration is as old as the file that carries it.
-    std::error_code ec;
-    const auto mtime = std::filesystem::last_write_time(calibration_source_, ec);
-    if (!ec) {
-        const auto age = std::filesystem::file_time_type::clock::now() - mtime;
-        out.age_s = std::chrono::duration_cast<std::chrono::seconds>(age).count();
-    }
-    return out;
 }
 
 }  // namespace boxd

@@ -7,6 +7,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <mutex>
@@ -31,6 +32,11 @@ struct DeviceStationConfig {
     std::filesystem::path calibration_file;
 };
 
+// The one owner of the station's devices. Every open, re-open, capture and close runs under one
+// lifecycle lock, so no two threads open, replace or close the devices at once, and a capture
+// keeps them (shared) until it returns. Opens coalesce: a caller that arrives while another
+// thread opens waits for that open and takes its answer instead of opening again. Shutdown()
+// abandons an open in progress (a drive still starting, homing) and refuses later ones.
 class DeviceStation : public Station {
 public:
     explicit DeviceStation(DeviceStationConfig config);
@@ -47,9 +53,12 @@ public:
     CalibrationInForce Calibration() const override;
 
 private:
+    // Opens the devices and homes the table; the caller holds lifecycle_mutex_.
+    Status OpenLocked();
     // Records a device error: the devices are closed and reopened before the next run.
     void MarkDeviceError(const Error& error);
-    void CloseDevices();
+    // Stops the table and closes the camera; the caller holds lifecycle_mutex_.
+    void CloseLocked();
     // Captures one session with the open devices; progress is reported as "capture".
     // Captures a session; with a `preparer`, each pose is handed to it as soon as it is grabbed.
     Result<Session> Capture(const JobContext& ctx, double& capture_ms,
@@ -58,14 +67,22 @@ private:
     // config file's.
     void LoadStoredCalibration();
 
-    DeviceStationConfig config_;
-    // Guards devices_ against RequestStop() from another thread while Open() replaces them.
+    // Held for the whole of an open, a close or a capture: the devices' one lifecycle. Taken
+    // before devices_mutex_, never after it.
+    std::mutex lifecycle_mutex_;
+    // Guards the fields below for the quick readers (RequestStop, Devices, Calibration), which
+    // never wait for a device.
     mutable std::mutex devices_mutex_;
-    std::unique_ptr<StationDevices> devices_;
+    DeviceStationConfig config_;  // its calibration is written under both locks
+    std::shared_ptr<StationDevices> devices_;
+    std::shared_ptr<StationDevices> opening_;  // being homed by Open(), for RequestStop()
     std::atomic<bool> open_{false};
-    std::optional<Error> device_error_;         // guarded by devices_mutex_
-    std::string turntable_description_;         // guarded by devices_mutex_
-    std::string camera_description_;            // guarded by devices_mutex_
+    std::atomic<bool> stopping_{false};  // Shutdown(): opens are abandoned and refused
+    std::uint64_t opens_finished_ = 0;   // opens that have returned, and the last one's answer
+    Status last_open_ = OkStatus();
+    std::optional<Error> device_error_;
+    std::string turntable_description_;
+    std::string camera_description_;
     std::filesystem::path calibration_source_;  // the file the calibration in force came from
     // When the last pose of the capture in progress was grabbed (the job thread's).
     std::chrono::steady_clock::time_point last_frame_at_;

@@ -80,21 +80,59 @@ void MeasurementService::Notify() {
     if (f) f();
 }
 
-Status MeasurementService::OpenStation() {
-    std::shared_ptr<Station> station = this->station();
+Status MeasurementService::OpenStation() { return OpenStation(station()); }
+
+Status MeasurementService::OpenStation(const std::shared_ptr<Station>& station) {
     Status s = station->Open();
     {
         std::lock_guard lock(mutex_);
-        station_ok_ = s.ok();
+        if (station != station_) return s;  // replaced meanwhile: its outcome is not the state
         station_opened_ = true;
-        if (!s) {
+        if (!s && s.error().code != ErrorCode::kShuttingDown) {
             last_error_ = s.error();
             last_error_at_ = UtcTimestampNow();
         }
     }
-    if (!s) metrics_.RecordFault(s.error().code);
+    if (!s && s.error().code != ErrorCode::kShuttingDown) metrics_.RecordFault(s.error().code);
     Notify();
     return s;
+}
+
+void MeasurementService::OpenStationInBackground() {
+    bool claimed = false;
+    {
+        std::lock_guard lock(mutex_);
+        claimed = ClaimOpenerLocked();
+    }
+    if (claimed) LaunchOpener();
+}
+
+bool MeasurementService::ClaimOpenerLocked() {
+    if (opening_ || shutting_down_ || replacing_) return false;
+    opening_ = true;
+    return true;
+}
+
+void MeasurementService::LaunchOpener() {
+    std::thread previous;
+    {
+        std::lock_guard lock(mutex_);
+        previous = std::move(opener_);  // a finished opener: only its thread is left
+        opener_ = std::thread([this, station = station_] {
+            if (Status s = OpenStation(station); !s) {
+                spdlog::error("the station is not ready ({}); measurements will retry the devices",
+                              s.error().message);
+            }
+            {
+                std::lock_guard done(mutex_);
+                opening_ = false;
+            }
+            finished_cv_.notify_all();
+            Notify();
+        });
+    }
+    if (previous.joinable()) previous.join();
+    Notify();
 }
 
 std::shared_ptr<Station> MeasurementService::station() const {
@@ -103,13 +141,29 @@ std::shared_ptr<Station> MeasurementService::station() const {
 }
 
 Status MeasurementService::ReplaceStation(std::shared_ptr<Station> station, bool keep_sessions) {
+    std::shared_ptr<Station> old;
     {
         std::lock_guard lock(mutex_);
         if (running_) return Error{ErrorCode::kBusy, "a measurement is running"};
+        replacing_ = true;  // Claim() answers BUSY from here on
+        old = station_;
+    }
+    // The old station lets go of its devices (an open of them under way is abandoned) before the
+    // new one opens them.
+    old->Shutdown();
+    std::thread opener;
+    {
+        std::lock_guard lock(mutex_);
+        opener = std::move(opener_);
+    }
+    if (opener.joinable()) opener.join();
+    {
+        std::lock_guard lock(mutex_);
         station_ = std::move(station);
         keep_sessions_ = keep_sessions;
-        station_ok_ = false;
         station_opened_ = false;
+        opening_ = false;
+        replacing_ = false;
     }
     Notify();
     return OkStatus();
@@ -118,6 +172,7 @@ Status MeasurementService::ReplaceStation(std::shared_ptr<Station> station, bool
 Result<std::thread> MeasurementService::Claim(bool calibrating) {
     std::lock_guard lock(mutex_);
     if (shutting_down_) return Error{ErrorCode::kShuttingDown, "the daemon is stopping"};
+    if (replacing_) return Error{ErrorCode::kBusy, "the station is being reloaded"};
     if (running_) {
         return Error{ErrorCode::kBusy, calibrating_ ? std::string("a calibration is running")
                                                     : "measurement " + current_id_ + " is running"};
@@ -225,7 +280,7 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
     LogMeasurement(r);
     metrics_.RecordMeasurement(r);
     if (on_finished_) on_finished_(r);
-    const bool station_ok = station->IsOpen();
+    bool reopen = false;
     {
         std::lock_guard lock(mutex_);
         running_ = false;
@@ -235,7 +290,6 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
         recent_.push_back(r);
         if (recent_.size() > kRecentResults) recent_.pop_front();
         ++finished_;
-        station_ok_ = station_ok;
         if (!saved) {
             last_error_ = saved.error();
             last_error_at_ = r.finished_at;
@@ -243,9 +297,14 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
             last_error_ = Error{r.reason->code, r.reason->message};
             last_error_at_ = r.finished_at;
         }
+        // A device fault closed the devices: they are opened again now, not when the next parcel
+        // is already waiting (which then waits for this open). Claimed with the run's end, so
+        // the state goes from measuring to starting without a moment of error.
+        reopen = !station->IsOpen() && ClaimOpenerLocked();
     }
     finished_cv_.notify_all();
     Notify();
+    if (reopen) LaunchOpener();
     // A measurement frees a few hundred megabytes of clouds: hand them back to the system now
     // rather than keep them for the next one (glibc keeps freed memory in its arenas).
     malloc_trim(0);
@@ -276,12 +335,18 @@ void MeasurementService::Abort() {
 }
 
 void MeasurementService::Join() {
-    std::thread t;
+    std::thread worker, opener;
     {
-        std::lock_guard lock(mutex_);
-        t = std::move(worker_);
+        // A run that was claimed but whose thread is not made yet (Start() reserving its id),
+        // and an open claimed but not launched, are waited for too: their threads exist once
+        // the flags are down again.
+        std::unique_lock lock(mutex_);
+        finished_cv_.wait(lock, [this] { return !running_ && !opening_; });
+        worker = std::move(worker_);
+        opener = std::move(opener_);
     }
-    if (t.joinable()) t.join();
+    if (worker.joinable()) worker.join();
+    if (opener.joinable()) opener.join();
 }
 
 bool MeasurementService::Busy() const {
@@ -292,10 +357,12 @@ bool MeasurementService::Busy() const {
 ServiceSnapshot MeasurementService::Snapshot() const {
     std::lock_guard lock(mutex_);
     ServiceSnapshot s;
-    s.state = running_      ? (calibrating_ ? ServiceState::kCalibrating : ServiceState::kMeasuring)
-              : station_ok_ ? ServiceState::kIdle
-              : station_opened_ ? ServiceState::kError
-                                : ServiceState::kStarting;  // the devices are still coming up
+    // The station's own flag is the truth of its devices (an atomic: never waits on them).
+    s.state = running_   ? (calibrating_ ? ServiceState::kCalibrating : ServiceState::kMeasuring)
+              : opening_ ? ServiceState::kStarting  // the devices are coming up
+              : station_->IsOpen() ? ServiceState::kIdle
+              : station_opened_    ? ServiceState::kError
+                                   : ServiceState::kStarting;
     s.measurement_id = current_id_;
     s.progress = progress_;
     s.last_error = last_error_;

@@ -50,6 +50,10 @@ public:
 
     // Brings the station's devices up; on failure the state is `error` with the device error.
     Status OpenStation();
+    // Brings the station's devices up on a thread of their own (at start, after a reload, after
+    // a device fault), unless that is already under way; the state is `starting` meanwhile. A
+    // measurement started meanwhile waits for that open (Station::Open coalesces).
+    void OpenStationInBackground();
 
     // Starts a measurement (of the parcel `parcel_id`, when given: kept with its result) and
     // returns its id, or BUSY while one runs, SHUTTING_DOWN after Abort(), STORAGE_ERROR when no
@@ -71,7 +75,7 @@ public:
 
     // Stops the running measurement (the table is stopped at once) and refuses new ones.
     void Abort();
-    // Waits until no measurement runs.
+    // Waits until no measurement runs and no background open is under way.
     void Join();
 
     bool Busy() const;
@@ -81,7 +85,9 @@ public:
     std::shared_ptr<Station> station() const;
 
     // Puts a new station (and the keep-sessions setting) in force; BUSY while a run uses the
-    // old one. The new station's devices are opened by the caller (OpenStation()).
+    // old one. Runs are refused (BUSY) while the old station is shut down (an open of it under
+    // way is abandoned) and replaced. The new station's devices are opened by the caller
+    // (OpenStation...()).
     Status ReplaceStation(std::shared_ptr<Station> station, bool keep_sessions);
 
     // Called (from any thread) whenever the state or the progress changes.
@@ -93,6 +99,12 @@ public:
     }
 
 private:
+    // Opens `station`'s devices; records the outcome if it is still the station in force.
+    Status OpenStation(const std::shared_ptr<Station>& station);
+    // Claims the background open (under mutex_); false when one is under way or none may start.
+    bool ClaimOpenerLocked();
+    // Starts the claimed background open of the station in force.
+    void LaunchOpener();
     void Run(std::string id, std::filesystem::path scratch, std::shared_ptr<Station> station,
              std::optional<std::string> parcel_id);
     JobOutput RunStation(Station& station, const JobContext& ctx);
@@ -111,8 +123,10 @@ private:
     std::condition_variable finished_cv_;
     std::shared_ptr<Station> station_;
     bool keep_sessions_ = false;
-    bool station_ok_ = false;
     bool station_opened_ = false;  // OpenStation() has run on the station in force
+    bool opening_ = false;         // OpenStationInBackground() is under way
+    bool replacing_ = false;       // ReplaceStation() is under way: no run, no open starts
+    std::thread opener_;           // its thread
     bool running_ = false;
     bool calibrating_ = false;
     bool shutting_down_ = false;

@@ -86,22 +86,23 @@ void MeasurementService::RunCalibration(std::shared_ptr<CalibrationJob> job,
     }
     RecordCalibration(job->reference, result);
     if (!result) metrics_.RecordFault(result.error().code);
-    const bool station_ok = station->IsOpen();
+    bool reopen = false;
     {
         std::lock_guard lock(mutex_);
         running_ = false;
         calibrating_ = false;
         progress_ = JobProgress{};
-        station_ok_ = station_ok;
         if (!result) {
             last_error_ = result.error();
             last_error_at_ = UtcTimestampNow();
         }
         job->result = std::move(result);
         job->done = true;
+        reopen = !station->IsOpen() && ClaimOpenerLocked();  // as after a measurement
     }
     finished_cv_.notify_all();
     Notify();
+    if (reopen) LaunchOpener();
 }
 
 }  // namespace boxd

@@ -135,7 +135,7 @@ void MqttPublisher::PublishState(std::string payload) {
 }
 
 void MqttPublisher::FlushLocked() {
-    if (!connected_) return;
+    if (!connected_ || stopped_) return;  // after Stop() only its goodbye goes out
     if (!state_sent_ && !state_.empty()) {
         state_sent_ = mosquitto_publish(client_, nullptr, status_topic_.c_str(),
                                         static_cast<int>(state_.size()), state_.data(), kQos,
@@ -159,6 +159,9 @@ void MqttPublisher::OnConnect(int rc) {
         return;
     }
     std::lock_guard lock(mutex_);
+    // A reconnect that lands while Stop() says goodbye must not send the state after the
+    // "offline" it published (nor keep the broker from its last will).
+    if (stopped_) return;
     spdlog::info("mqtt: connected to {}:{}{}", config_.host, config_.EffectivePort(),
                  backlog_.empty() ? "" : fmt::format(", sending {} waiting", backlog_.size()));
     connected_ = true;

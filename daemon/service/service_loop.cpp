@@ -111,10 +111,9 @@ Status ServiceLoop::Run() {
     }
     if (Status s = api_->Start(); !s) return BadConfig(s.error().message);
 
-    if (Status s = service_->OpenStation(); !s) {
-        spdlog::error("the station is not ready ({}); measurements will retry the devices",
-                      s.error().message);
-    }
+    // The devices come up on their own thread (`starting`): the loop answers signals meanwhile,
+    // and a measurement requested before they are up waits for them.
+    service_->OpenStationInBackground();
     last_status_ = StatusLine(service_->Snapshot());
     notifier_.Ready(last_status_);
     spdlog::info("boxd serve ready: {}", last_status_);
@@ -149,8 +148,10 @@ Status ServiceLoop::Run() {
     notifier_.Stopping(busy ? "stopping: aborting the running measurement" : "stopping");
     spdlog::info("stopping{}", busy ? ": aborting the running measurement" : "");
     service_->Abort();
-    service_->Join();
+    // Before the join: an open still under way (a drive starting or homing) is abandoned, and a
+    // run waiting for it is answered, so the stop does not wait for a slow device.
     service_->station()->Shutdown();
+    service_->Join();
     if (mqtt_) mqtt_->Stop();  // the aborted run is sent first, then {"state": "offline"}
     api_->Stop();
     api_.reset();
@@ -200,16 +201,16 @@ void ServiceLoop::Reload() {
         fresh->storage.data_dir = config_.storage.data_dir;
     }
     store_->set_retention(fresh->storage.retention);
-    // The old station lets go of the devices before the new one opens them.
-    service_->station()->Shutdown();
     if (Status s = service_->ReplaceStation(MakeStation(*fresh), fresh->storage.keep_sessions);
         !s) {
-        spdlog::error("reload: {}", s.error().message);
+        // A run started since the loop saw the service idle: reload once it has finished.
+        spdlog::info("reload: {}; reloading after it", s.error().message);
+        reload_pending_ = true;
+        notifier_.Ready(StatusLine(service_->Snapshot()));
+        return;
     }
     config_ = std::move(*fresh);
-    if (Status s = service_->OpenStation(); !s) {
-        spdlog::error("reload: the station is not ready: {}", s.error().message);
-    }
+    service_->OpenStationInBackground();
     notifier_.Ready(StatusLine(service_->Snapshot()));
     spdlog::info("reload done");
 }

@@ -96,6 +96,10 @@ Result<std::unique_ptr<SimTurntableProcess>> SimTurntableProcess::Start(
             process->port_ = bound;
             break;
         }
+        if (launch.cancel != nullptr && launch.cancel->load()) {
+            cleanup();
+            return Error{ErrorCode::kAborted, "simulated turntable: its start was abandoned"};
+        }
         if (!process->Running()) {
             cleanup();
             return LaunchError("boxd sim-turntable exited at start (port " +

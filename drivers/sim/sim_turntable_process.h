@@ -6,6 +6,7 @@
 
 #include <sys/types.h>
 
+#include <atomic>
 #include <chrono>
 #include <filesystem>
 #include <memory>
@@ -21,11 +22,15 @@ struct SimTurntableLaunch {
     int port = 0;                   // loopback port; 0 picks a free one
     std::vector<std::string> args;  // further `boxd sim-turntable` options (speed, faults, ...)
     std::filesystem::path log;      // the child's stderr is appended here; empty: inherited
+    // Set (by another thread) to give up waiting for the child to listen: it is terminated and
+    // the start returns ABORTED.
+    const std::atomic<bool>* cancel = nullptr;
 };
 
 class SimTurntableProcess {
 public:
-    // Returns the started simulator once it listens, or a TURNTABLE_ERROR within 10 s.
+    // Returns the started simulator once it listens, a TURNTABLE_ERROR within 10 s, or ABORTED
+    // soon after launch.cancel is set.
     static Result<std::unique_ptr<SimTurntableProcess>> Start(const SimTurntableLaunch& launch);
     // Terminates the child (Terminate()).
     ~SimTurntableProcess();

@@ -55,6 +55,17 @@ protected:
         EXPECT_EQ(j["error"]["code"], code) << res->body;
         EXPECT_TRUE(j["error"]["message"].is_string());
     }
+    // Returns GET /v1/status once the devices are no longer coming up (a background open after
+    // a fault has answered).
+    nlohmann::json SettledStatus() {
+        nlohmann::json s;
+        for (int i = 0; i < 1000; ++i) {
+            s = Body(client_->Get("/v1/status"));
+            if (s["state"] != "starting") break;
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+        }
+        return s;
+    }
     void WaitUntilIdle() {
         for (int i = 0; i < 2000 && service_->Busy(); ++i) {
             std::this_thread::sleep_for(std::chrono::milliseconds(5));

@@ -20,8 +20,10 @@ public:
     std::atomic<int> stop_requests{0};
     std::atomic<bool> fail_next{false};
     std::atomic<bool> refuse_next{false};  // the next measurement is no_dim MULTIPLE_OBJECTS
+    std::atomic<bool> fail_open{false};    // opens fail (a drive that does not answer)
 
     Status Open() override {
+        if (fail_open) return Error{ErrorCode::kTurntableError, "sim: no answer"};
         open_ = true;
         return OkStatus();
     }

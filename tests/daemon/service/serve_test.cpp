@@ -361,6 +361,8 @@ TEST(ServeSystemd, SighupReloadsTheConfigAndSurvivesABrokenOne) {
     const json kept = daemon.GetJson("/v1/calibration");
     EXPECT_NEAR(kept["table_center_m"][0].get<double>(), x0 + 0.01, 1e-9) << kept.dump();
     EXPECT_NE(ReadText(dir / "serve.log").find("capture.poses"), std::string::npos);
+    // READY=1 comes once the API serves; the reloaded station's devices come up after it.
+    EXPECT_TRUE(daemon.WaitHealthy(30s));
     EXPECT_EQ(daemon.GetJson("/v1/status")["state"], "idle");
     daemon.process().Signal(SIGTERM);
     EXPECT_EQ(daemon.process().WaitExit(10s), 0) << ReadText(dir / "serve.log");
