@@ -45,6 +45,7 @@ struct SynthOptions {
     std::string shape = "box";
     double edge_radius_m = 0.0, bulge_m = 0.0, bulge_top_m = 0.0;
     double strap_m = 0.0, strap_width_m = 0.025, label_m = 0.0, flap_deg = 0.0;
+    double taper_m = 0.0;
     std::vector<double> second_dims, second_offset;
     std::optional<int> intruder_pose;
     bool force = false;
@@ -136,6 +137,7 @@ Result<SyntheticStationConfig> MakeConfig(const SynthOptions& o) {
     c.box.strap_width_m = o.strap_width_m;
     c.box.label_thickness_m = o.label_m;
     c.box.flap_deg = o.flap_deg;
+    c.box.taper_m = o.taper_m;
     if (!o.second_dims.empty()) {
         SyntheticBox second;
         second.length_m = o.second_dims.at(0);
@@ -261,7 +263,8 @@ void AddSynth(CLI::App& app, Runner& run) {
     sub->add_option("--angles", o->angles,
                     "Commanded pose angles (deg, any spacing); replaces --poses")
         ->delimiter(',');
-    sub->add_option("--shape", o->shape, "box, cylinder, lying_cylinder, l_shape or bag")
+    sub->add_option("--shape", o->shape,
+                    "box, cylinder, lying_cylinder, l_shape, bag, prism, wedge, frustum or pyramid")
         ->capture_default_str();
     sub->add_option("--edge-radius", o->edge_radius_m, "Rounded edges: radius (m)");
     sub->add_option("--bulge", o->bulge_m, "Side faces bulge out by this much (m)");
@@ -271,6 +274,8 @@ void AddSynth(CLI::App& app, Runner& run) {
         ->capture_default_str();
     sub->add_option("--label", o->label_m, "A label on a side face: thickness (m)");
     sub->add_option("--flap-deg", o->flap_deg, "A top flap opened by this angle (deg)");
+    sub->add_option("--taper-m", o->taper_m,
+                    "A frustum's sides come in by this much from the base to the top (m)");
     sub->add_option("--second-dims", o->second_dims, "A second box: length, width, height (m)")
         ->expected(3);
     sub->add_option("--second-offset", o->second_offset, "The second box's centre X Y (m)")

@@ -18,7 +18,11 @@ constexpr ShapeName kShapeNames[] = {{SyntheticShape::kBox, "box"},
                                      {SyntheticShape::kCylinder, "cylinder"},
                                      {SyntheticShape::kLyingCylinder, "lying_cylinder"},
                                      {SyntheticShape::kLShape, "l_shape"},
-                                     {SyntheticShape::kBag, "bag"}};
+                                     {SyntheticShape::kBag, "bag"},
+                                     {SyntheticShape::kPrism, "prism"},
+                                     {SyntheticShape::kWedge, "wedge"},
+                                     {SyntheticShape::kFrustum, "frustum"},
+                                     {SyntheticShape::kPyramid, "pyramid"}};
 
 Eigen::Matrix3d Yaw(double rad) {
     return Eigen::AngleAxisd(rad, Eigen::Vector3d::UnitZ()).matrix();
@@ -67,9 +71,9 @@ Result<SyntheticShape> ParseSyntheticShape(const std::string& name) {
     for (const auto& s : kShapeNames) {
         if (name == s.name) return s.shape;
     }
-    return Error{
-        ErrorCode::kInvalidInput,
-        "shape: must be box, cylinder, lying_cylinder, l_shape or bag, got '" + name + "'"};
+    std::string names;
+    for (const auto& s : kShapeNames) names += std::string(names.empty() ? "" : ", ") + s.name;
+    return Error{ErrorCode::kInvalidInput, "shape: must be one of " + names + ", got '" + name + "'"};
 }
 
 Status ValidateSyntheticObject(const SyntheticBox& b, const std::string& field) {
@@ -105,6 +109,12 @@ Status ValidateSyntheticObject(const SyntheticBox& b, const std::string& field) 
     if (features && b.shape != SyntheticShape::kBox) {
         return bad("shape", "edges, bulges, straps, labels and flaps belong to a box");
     }
+    const bool frustum = b.shape == SyntheticShape::kFrustum;
+    if (!std::isfinite(b.taper_m) || b.taper_m < 0.0 ||
+        (frustum && !(b.taper_m > 0.0 && b.taper_m < std::min(b.length_m, b.width_m) / 2.0))) {
+        return bad("taper_m", "a frustum's is in (0, half its base's smaller side)");
+    }
+    if (!frustum && b.taper_m > 0.0) return bad("taper_m", "belongs to a frustum");
     if (b.shape == SyntheticShape::kCylinder && std::abs(b.length_m - b.width_m) > 1e-9) {
         return bad("width_m", "a standing cylinder's length and width are its diameter");
     }
@@ -136,6 +146,14 @@ TriangleMesh SyntheticObjectMesh(const SyntheticBox& b) {
             const double r = 0.3 * std::min({l, w, h});
             return MakeBoxMesh(l, w, h, {r, 0.06 * std::min(l, w), 0.08 * h});
         }
+        case SyntheticShape::kPrism:
+            return MakeTaperedBoxMesh(l, w, h, l, 0.0);
+        case SyntheticShape::kWedge:
+            return MakeTaperedBoxMesh(l, w, h, l, 0.0, 0.0, -w / 2.0);
+        case SyntheticShape::kFrustum:
+            return MakeTaperedBoxMesh(l, w, h, l - 2.0 * b.taper_m, w - 2.0 * b.taper_m);
+        case SyntheticShape::kPyramid:
+            return MakeTaperedBoxMesh(l, w, h, 0.0, 0.0);
         case SyntheticShape::kBox:
             break;
     }

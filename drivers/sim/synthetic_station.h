@@ -22,6 +22,10 @@ enum class SyntheticShape {
     kLyingCylinder,  // a tube on its side along the length: diameter = width = height
     kLShape,         // the length x width footprint without one quarter, full height
     kBag,            // a soft bag: a well rounded, bulging length x width x height core
+    kPrism,          // a triangular prism lying on a face: length x width base, ridge on top
+    kWedge,          // a wedge lying on a face: its ridge above the -width edge (a right angle)
+    kFrustum,        // a tapered carton: length x width base, each side taper_m in at the top
+    kPyramid,        // a pyramid on its length x width base, apex above its centre
 };
 
 // An object on the table and where it stands at pose 0, in the table frame (metres, degrees).
@@ -42,6 +46,7 @@ struct SyntheticBox {
     double strap_width_m = 0.025;
     double label_thickness_m = 0.0;  // a label on the +width side
     double flap_deg = 0.0;           // a top flap hinged at the +length top edge, this far open
+    double taper_m = 0.0;            // a frustum's side comes in by this much from base to top
 
     // Returns true for a box without features.
     bool IsIdealBox() const {

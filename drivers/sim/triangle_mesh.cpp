@@ -115,6 +115,27 @@ TriangleMesh MakeCuboidMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi
     return mesh;
 }
 
+TriangleMesh MakeTaperedBoxMesh(double l, double w, double h, double top_l, double top_w,
+                                double top_dx, double top_dy) {
+    TriangleMesh mesh;
+    // Bottom corners 0-3 and top corners 4-7, counter-clockwise seen from above.
+    const double sx[4] = {-1, 1, 1, -1}, sy[4] = {-1, -1, 1, 1};
+    for (int k = 0; k < 4; ++k) mesh.vertices.emplace_back(sx[k] * l / 2, sy[k] * w / 2, 0.0);
+    for (int k = 0; k < 4; ++k) {
+        mesh.vertices.emplace_back(top_dx + sx[k] * top_l / 2, top_dy + sy[k] * top_w / 2, h);
+    }
+    // Quads as two triangles each, wound outwards; a degenerate top (ridge, apex) leaves
+    // triangles of zero area, which no ray hits.
+    auto quad = [&mesh](std::uint32_t a, std::uint32_t b, std::uint32_t c, std::uint32_t d) {
+        mesh.triangles.push_back({a, b, c});
+        mesh.triangles.push_back({a, c, d});
+    };
+    quad(0, 3, 2, 1);  // bottom, facing down
+    quad(4, 5, 6, 7);  // top, facing up
+    for (std::uint32_t k = 0; k < 4; ++k) quad(k, (k + 1) % 4, 4 + (k + 1) % 4, 4 + k);
+    return mesh;
+}
+
 TriangleMesh MakeCylinderMesh(double radius, double length, int segments) {
     TriangleMesh mesh;
     // Ring vertices at both ends, then the two cap centres.

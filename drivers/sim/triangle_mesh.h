@@ -39,6 +39,13 @@ TriangleMesh MakeBoxMesh(double l, double w, double h, const BoxDeformation& def
 // Returns the axis-aligned box [lo, hi] (a strap, a label, a flap panel before it is turned).
 TriangleMesh MakeCuboidMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 
+// Returns a closed solid with planar faces standing on z = 0: an l x w rectangle centred on the z
+// axis at the bottom, and at height h a top_l x top_w rectangle centred at (top_dx, top_dy). A
+// top of zero width is a ridge (a prism or wedge lying on a face), of zero size an apex (a
+// pyramid); a smaller top a frustum (a tapered carton).
+TriangleMesh MakeTaperedBoxMesh(double l, double w, double h, double top_l, double top_w,
+                                double top_dx = 0.0, double top_dy = 0.0);
+
 // Returns a closed cylinder of `radius` and `length` along +z from z = 0, with `segments` sides.
 TriangleMesh MakeCylinderMesh(double radius, double length, int segments = 360);
 

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 #include <string>
 
@@ -82,12 +84,49 @@ TEST(SyntheticEnclosingCuboid, CylindersLShapeAndBag) {
     // A bag: its core plus sides bulging by 6% of the smaller side, the top by 8% of the height.
     ExpectDims(SyntheticEnclosingCuboid(Shape(SyntheticShape::kBag, 0.4, 0.3, 0.2)),
                0.4 + 2 * 0.018, 0.3 + 2 * 0.018, 0.2 + 0.016, kFloatTol);
+    // Shapes widest at the table: their base is the footprint, however far they taper.
+    for (SyntheticShape s : {SyntheticShape::kPrism, SyntheticShape::kWedge,
+                             SyntheticShape::kPyramid}) {
+        ExpectDims(SyntheticEnclosingCuboid(Shape(s, 0.45, 0.12, 0.104)), 0.45, 0.12, 0.104,
+                   kFloatTol);
+    }
+    SyntheticBox frustum = Shape(SyntheticShape::kFrustum, 0.4, 0.3, 0.25);
+    frustum.taper_m = 0.025;
+    ExpectDims(SyntheticEnclosingCuboid(frustum), 0.4, 0.3, 0.25, kFloatTol);
+}
+
+// The tapered solids are closed and wound outwards: their volume by the divergence theorem is
+// the solid's (a prism's half the base times the height, a pyramid's a third).
+TEST(SyntheticObjectMesh, TaperedSolidsAreClosedAndWoundOutwards) {
+    auto volume = [](const TriangleMesh& m) {
+        double v = 0.0;
+        for (const auto& t : m.triangles) {
+            const Eigen::Vector3d a = m.vertices[t[0]].cast<double>(),
+                                  b = m.vertices[t[1]].cast<double>(),
+                                  c = m.vertices[t[2]].cast<double>();
+            v += a.dot(b.cross(c)) / 6.0;
+        }
+        return v;
+    };
+    const double l = 0.45, w = 0.12, h = 0.104;
+    EXPECT_NEAR(volume(SyntheticObjectMesh(Shape(SyntheticShape::kPrism, l, w, h))), l * w * h / 2,
+                1e-7);
+    EXPECT_NEAR(volume(SyntheticObjectMesh(Shape(SyntheticShape::kWedge, l, w, h))), l * w * h / 2,
+                1e-7);
+    EXPECT_NEAR(volume(SyntheticObjectMesh(Shape(SyntheticShape::kPyramid, l, w, h))),
+                l * w * h / 3, 1e-7);
+    SyntheticBox frustum = Shape(SyntheticShape::kFrustum, 0.4, 0.3, 0.25);
+    frustum.taper_m = 0.025;
+    // Prismatoid: h/6 (A_bottom + 4 A_middle + A_top).
+    const double expected = 0.25 / 6 * (0.4 * 0.3 + 4 * 0.375 * 0.275 + 0.35 * 0.25);
+    EXPECT_NEAR(volume(SyntheticObjectMesh(frustum)), expected, 1e-7);
 }
 
 TEST(SyntheticShapeName, RoundTripsAndABadNameIsAnErrorNamingIt) {
     for (SyntheticShape s :
          {SyntheticShape::kBox, SyntheticShape::kCylinder, SyntheticShape::kLyingCylinder,
-          SyntheticShape::kLShape, SyntheticShape::kBag}) {
+          SyntheticShape::kLShape, SyntheticShape::kBag, SyntheticShape::kPrism,
+          SyntheticShape::kWedge, SyntheticShape::kFrustum, SyntheticShape::kPyramid}) {
         auto parsed = ParseSyntheticShape(SyntheticShapeName(s));
         ASSERT_TRUE(parsed.ok()) << SyntheticShapeName(s);
         EXPECT_EQ(*parsed, s);
@@ -132,6 +171,14 @@ TEST(ValidateSyntheticObject, NamesTheFieldOfAShapeThatIsNone) {
     b = Box(0.4, 0.3, 0.2);
     b.flap_deg = 190.0;
     expect_field(b, "flap_deg");
+    // A frustum's taper leaves it a top; no other shape has one.
+    SyntheticBox frustum = Shape(SyntheticShape::kFrustum, 0.4, 0.3, 0.2);
+    expect_field(frustum, "taper_m");
+    frustum.taper_m = 0.15;
+    expect_field(frustum, "taper_m");
+    b = Box(0.4, 0.3, 0.2);
+    b.taper_m = 0.01;
+    expect_field(b, "taper_m");
     expect_field(Box(0.4, 0.0, 0.2), "width_m");
 }
 
