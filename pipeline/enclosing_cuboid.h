@@ -23,6 +23,18 @@
 // The object is a cuboid when its box fit succeeded, its footprint fills the rectangle and no
 // face stands out of its plane by more than a small fraction of the box.
 //   - One view: the cuboid is assumed (its unseen faces where the top's edges end), and said so.
+//
+// The principle: every part of the enclosing cuboid that no reading supports is bounded by
+// physics and carried into the bound (sigma_m, and so uncertainty_m), or the measurement is
+// refused. Carried so far:
+//   - the foot band (the readings within min_z_m of the table are the table's): a wall sloping
+//     outward is extended down to the table at its slope, the extension's own uncertainty and
+//     the bend of its profile in the bound; an upright wall stays where it is (foot_band.h);
+//   - a side no view faced: refused (support_envelope.cpp), or for one view assumed and tested
+//     (single_view_cuboid.h);
+//   - a top no view saw from above: the walls' ends, with their noise (HeightNoiseSigma).
+// Not yet carried: depth missing next to the silhouette (a dark band, a projector shadow) is
+// read as free space.
 
 #include <Eigen/Core>
 #include <array>

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <utility>
 
+#include "pipeline/foot_band.h"
 #include "pipeline/layer_marks.h"
 #include "pipeline/parallel_for.h"
 #include "pipeline/surface_cells.h"
@@ -144,6 +145,13 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
         farther(fine, std::max(along, height), forward, true, true);
         farther(coarse, 2.0 * std::max(along, height), forward, false, false);
         farther(thin, std::max(along, height / 2.0), forward, true, false);
+        // Below the lowest row: a wall sloping outward goes on to the table (foot_band.h).
+        const FootReach foot = ExtrapolateFoot(forward ? fine.front : fine.back, config);
+        double& best = forward ? out.forward : out.backward;
+        if (foot.reach > best) {
+            best = foot.reach;
+            (forward ? out.se_forward : out.se_backward) = foot.se;
+        }
     }
     return out;
 }

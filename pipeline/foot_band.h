@@ -1,0 +1,30 @@
+#pragma once
+// The foot band: the readings within EnvelopeConfig::min_z_m of the table are taken as table, so
+// the last centimetre of every wall is read by nothing. Where a wall stands upright that costs
+// nothing; where it slopes outward down to the table (a prism or a wedge lying on a face, a
+// frustum, a pyramid, a sack) its widest part is in that band, and the support read above it
+// falls short by the slope times the band's height (a 60 degree flank read 13 mm narrow over a
+// 12 mm band). The principle (enclosing_cuboid.h): what no reading supports is carried by
+// physics into the reach and its bound. Here: the wall's profile just above the band (its two
+// lowest rows of cells) is extended down to the table; its uncertainty, and how much the
+// profile's slope changes from one row to the next (a bulging foot keeps bending), go into the
+// standard error.
+
+#include "pipeline/enclosing_cuboid.h"
+#include "pipeline/surface_cells.h"
+
+namespace boxd::envelope {
+
+struct FootReach {
+    double reach = -INFINITY;  // where the wall meets the table (along the layer's direction)
+    double se = 0.0;           // its standard error
+    double slope = 0.0;        // the wall's outward run per metre of height, going down
+};
+
+// Returns the foot of the outer layer `layer` (cells of (across, up), up from the table top, as
+// support_envelope.cpp builds them): -INFINITY when the wall does not reach down to the band,
+// or does not slope outward beyond its noise there (an upright or undercut wall stays where its
+// readings are).
+FootReach ExtrapolateFoot(const CellGrid<LayerCell>& layer, const EnvelopeConfig& config);
+
+}  // namespace boxd::envelope

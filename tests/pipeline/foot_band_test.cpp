@@ -1,0 +1,98 @@
+// Known-answer tests of the foot band (pipeline/foot_band.h): a wall's outer layer read from the
+// band's top up, as the support function bins it, and where the extension puts the wall's foot
+// on the table — a flank sloping outward (a prism's, a frustum's), an upright wall, an undercut
+// one, a wall that starts high above the table, and a bending profile, over several seeds.
+#include "pipeline/foot_band.h"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <random>
+
+namespace boxd::envelope {
+namespace {
+
+constexpr double kSigma = 0.0015;  // a Kinect's noise across a wall at a metre
+
+// The outer layer in one direction of a wall 0.3 m across whose reach at height z is
+// `profile(z)`, read every 2 mm across and 1 mm up from `lowest` to `top` with noise kSigma.
+CellGrid<LayerCell> Layer(const std::function<double(double)>& profile, double lowest, double top,
+                          unsigned seed, const EnvelopeConfig& config) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, kSigma);
+    CellGrid<LayerCell> grid(-0.2, 0.2, 0.0, top + 0.01, config.cell_along_m, config.cell_height_m);
+    for (double z = lowest; z <= top; z += 0.001) {
+        for (double t = -0.15; t <= 0.15; t += 0.002) {
+            if (LayerCell* c = grid.At(t, z)) c->Add3(t, z, profile(z) + noise(rng));
+        }
+    }
+    return grid;
+}
+
+TEST(FootBand, AFlankSlopingOutwardIsExtendedToTheTable) {
+    const EnvelopeConfig config;
+    // A prism's flank: 60 mm out at the table, coming in 0.577 m per metre of height.
+    auto prism = [](double z) { return 0.060 - 0.577 * z; };
+    for (unsigned seed = 1; seed <= 5; ++seed) {
+        const FootReach foot = ExtrapolateFoot(Layer(prism, config.min_z_m, 0.1, seed, config),
+                                               config);
+        ASSERT_TRUE(std::isfinite(foot.reach)) << "seed " << seed;
+        EXPECT_NEAR(foot.slope, 0.577, 0.05) << "seed " << seed;
+        // Its readings stop 7 mm short of the foot; the extension lands within its bound.
+        EXPECT_LT(std::abs(foot.reach - 0.060), 2.0 * foot.se + 1e-4) << "seed " << seed;
+        EXPECT_LT(foot.se, 0.002) << "seed " << seed;
+    }
+}
+
+TEST(FootBand, UprightAndUndercutWallsStayWhereTheirReadingsAre) {
+    const EnvelopeConfig config;
+    int extended = 0;
+    for (unsigned seed = 1; seed <= 20; ++seed) {
+        auto upright = [](double) { return 0.2; };
+        auto undercut = [](double z) { return 0.2 + 0.3 * z; };  // a bag's bottom curling in
+        extended += std::isfinite(
+            ExtrapolateFoot(Layer(upright, config.min_z_m, 0.2, seed, config), config).reach);
+        EXPECT_FALSE(std::isfinite(
+            ExtrapolateFoot(Layer(undercut, config.min_z_m, 0.2, seed, config), config).reach));
+    }
+    // An upright wall's noise alone passes the slope test about once in 700.
+    EXPECT_EQ(extended, 0);
+}
+
+// One row standing out alone is no flank: stray readings at an upright wall's foot.
+TEST(FootBand, ALowestRowStandingOutAloneIsNotExtended) {
+    const EnvelopeConfig config;
+    auto stray = [&config](double z) {
+        return z < config.min_z_m + config.cell_height_m ? 0.21 : 0.2;
+    };
+    EXPECT_FALSE(
+        std::isfinite(ExtrapolateFoot(Layer(stray, config.min_z_m, 0.2, 1, config), config).reach));
+}
+
+TEST(FootBand, AWallWhoseReadingsStartHighHasNoFootHere) {
+    const EnvelopeConfig config;
+    // An overhang: the wall's lowest readings 50 mm up, sloping outward below that.
+    auto overhang = [](double z) { return 0.1 - 0.5 * z; };
+    EXPECT_FALSE(
+        std::isfinite(ExtrapolateFoot(Layer(overhang, 0.05, 0.2, 1, config), config).reach));
+}
+
+TEST(FootBand, ABendingFootWidensTheBound) {
+    const EnvelopeConfig config;
+    // A sack's foot: its flank flares ever faster towards the table (its outward slope grows
+    // by 8 per metre going down: 0.21 at 36 mm, 0.31 at 24 mm, 0.5 at the table).
+    auto sack = [](double z) { return 0.1 - 0.5 * z + 4.0 * z * z; };
+    auto flat = [](double z) { return 0.1 - 0.5 * z; };
+    for (unsigned seed = 1; seed <= 5; ++seed) {
+        const FootReach bending = ExtrapolateFoot(Layer(sack, config.min_z_m, 0.05, seed, config),
+                                                  config);
+        const FootReach straight = ExtrapolateFoot(Layer(flat, config.min_z_m, 0.05, seed, config),
+                                                   config);
+        ASSERT_TRUE(std::isfinite(bending.reach) && std::isfinite(straight.reach));
+        EXPECT_GT(bending.se, straight.se) << "seed " << seed;
+        EXPECT_LT(std::abs(bending.reach - sack(0.0)), 2.0 * bending.se) << "seed " << seed;
+    }
+}
+
+}  // namespace
+}  // namespace boxd::envelope
