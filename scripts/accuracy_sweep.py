@@ -21,6 +21,12 @@ With --objects few it draws cartons seen from 1-5 poses, evenly or unevenly spac
 few-poses promise: within 5 mm, or refused with its reason); with --objects pairs, two cartons
 2-8 cm apart, which must all be refused MULTIPLE_OBJECTS.
 
+With --objects shapes it draws shapes nobody tuned to, of a kind drawn evenly: prisms and
+wedges lying on a face, frusta (cartons tapering 5-40 mm a side), pyramids, bags and lying tubes,
+on stations drawn as for the parcels; each kind is reported per sensor. For every mode the
+summary counts confident wrong numbers: a dimension whose true error is larger than twice its
+reported 95% bound plus 1 mm.
+
 With --one-pose each object is seen from one pose only (the cuboid assumption: within 5 mm and
 its bounds, or refused).
 
@@ -30,11 +36,12 @@ away), 12-24 poses of 2-5 frames; the summary says which are flat (at most half 
 wide).
 
 Usage: scripts/accuracy_sweep.py [--boxd build/daemon/boxd]
-                                 [--objects boxes|parcels|small|few|pairs]
+                                 [--objects boxes|parcels|small|few|pairs|shapes]
                                  [--seed 1] [--count 60] [--jobs 2] [--one-pose]
 Exit status 1 when a measured object is off by more than --fail-above-mm (default 1.0 for
 boxes, 3.0 for parcels, 2.0 for small cartons, 5.0 for few poses and one pose) in any dimension, or no case
-could be measured, or one is refused NO_OBJECT; for pairs, when any pair is measured or refused with another code.
+could be measured, or one is refused NO_OBJECT; for pairs, when any pair is measured or refused with another code;
+for shapes, when any number is confidently wrong.
 """
 import argparse
 import concurrent.futures
@@ -126,6 +133,33 @@ def draw_parcel(rng, index, seed):
         "args": [*parcel_station(rng, (length, width, height), 1000 * seed + index, [2, 3, 4],
                                  (0.85, 1.15)), *features],
     }
+
+
+SHAPE_KINDS = ("prism", "wedge", "frustum", "pyramid", "bag", "lying tube")
+
+
+def draw_shape(rng, index, seed):
+    """One shape of a kind drawn evenly, its station drawn as for the parcels; its kind names
+    the sensor too."""
+    kind = SHAPE_KINDS[rng.randrange(len(SHAPE_KINDS))]
+    length = rng.uniform(0.15, 0.5)
+    width = rng.uniform(0.1, length)
+    height = rng.uniform(0.06, 0.35)
+    shape = {"lying tube": "lying_cylinder"}.get(kind, kind)
+    features = ["--shape", shape]
+    if kind == "frustum":
+        features += ["--taper-m", f"{rng.uniform(0.005, min(0.04, 0.3 * width)):.3f}"]
+    elif kind == "lying tube":
+        width = height = rng.uniform(0.06, 0.2)
+    station = parcel_station(rng, (length, width, height), 1000 * seed + index, [2, 3, 4],
+                             (0.85, 1.15))
+    noise = station[station.index("--noise") + 1]
+    return {"name": f"h{seed}_{index}", "kind": f"{kind} {noise}", "args": [*station, *features]}
+
+
+def confidently_wrong(error_mm, bound_mm):
+    """A number a carrier would bill by that is wrong by more than its bound says it could be."""
+    return abs(error_mm) > 2.0 * bound_mm + 1.0
 
 
 def draw_small(rng, index, seed):
@@ -222,17 +256,19 @@ def main():
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--count", type=int, default=60)
     parser.add_argument("--jobs", type=int, default=2)
-    parser.add_argument("--objects", choices=("boxes", "parcels", "small", "few", "pairs"), default="boxes")
+    parser.add_argument("--objects", choices=("boxes", "parcels", "small", "few", "pairs", "shapes"),
+                        default="boxes")
     parser.add_argument("--fail-above-mm", type=float)
     parser.add_argument("--one-pose", action="store_true",
                         help="see each object from one pose only, at an angle drawn from SEED")
     args = parser.parse_args()
     if args.fail_above_mm is None:
         args.fail_above_mm = 5.0 if args.one_pose else {
-            "boxes": 1.0, "parcels": 3.0, "small": 2.0, "few": 5.0, "pairs": 0.0}[args.objects]
+            "boxes": 1.0, "parcels": 3.0, "small": 2.0, "few": 5.0, "pairs": 0.0,
+            "shapes": math.inf}[args.objects]
     rng = random.Random(args.seed)
     draw = {"boxes": draw_case, "parcels": draw_parcel, "small": draw_small, "few": draw_few,
-            "pairs": draw_pair}[args.objects]
+            "pairs": draw_pair, "shapes": draw_shape}[args.objects]
     cases = [draw(rng, i, args.seed) for i in range(args.count)]
     if args.one_pose:
         for case in cases:
@@ -278,14 +314,29 @@ def main():
           f"({100.0 * within / len(pairs):.0f}%; {per_dimension} of {len(measured)})")
     print(f"median bound {statistics.median(b for _, b in pairs):.2f} mm, "
           f"median |error| {statistics.median(e for e, _ in pairs):.2f} mm")
-    for kind in sorted({o["kind"] for o in measured if "kind" in o}):
-        mine = [(abs(e), b) for o in measured if o.get("kind") == kind
-                for e, b in zip(o["error_mm"], o["bound_mm"])]
-        print(f"  {kind:10s}: worst |error| {max(e for e, _ in mine):.2f} mm, "
-              f"{sum(e <= b for e, b in mine)} of {len(mine)} within their bound")
+    wrong = sum(confidently_wrong(e, b) for e, b in pairs)
+    print(f"confident wrong numbers (|error| > 2 x bound + 1 mm): {wrong} of {len(pairs)}")
+    for kind in sorted({o["kind"] for o in outcomes if "kind" in o}):
+        print("  " + kind_line(kind, [o for o in outcomes if o.get("kind") == kind]))
     worst = max(e for e, _ in pairs)
     blind = any(o.get("reason") == "NO_OBJECT" for o in outcomes)  # every case shows an object
+    if args.objects == "shapes":
+        return 1 if wrong or blind else 0
     return 1 if worst > args.fail_above_mm or blind else 0
+
+
+def kind_line(kind, outcomes):
+    """One kind's figures: measured, refused by code, worst error, coverage, confident wrong."""
+    measured = [o for o in outcomes if "error_mm" in o]
+    refused = sorted(o.get("reason", o["status"]) for o in outcomes if "error_mm" not in o)
+    codes = ", ".join(f"{c} {refused.count(c)}" for c in sorted(set(refused))) or "none refused"
+    mine = [(abs(e), b) for o in measured for e, b in zip(o["error_mm"], o["bound_mm"])]
+    if not mine:
+        return f"{kind:18s}: 0 of {len(outcomes)} measured ({codes})"
+    return (f"{kind:18s}: {len(measured)} of {len(outcomes)} measured ({codes}); worst |error| "
+            f"{max(e for e, _ in mine):.2f} mm, {sum(e <= b for e, b in mine)} of {len(mine)} "
+            f"within their bound, {sum(confidently_wrong(e, b) for e, b in mine)} confidently "
+            f"wrong")
 
 
 if __name__ == "__main__":
