@@ -46,7 +46,7 @@ struct SynthOptions {
     double edge_radius_m = 0.0, bulge_m = 0.0, bulge_top_m = 0.0;
     double strap_m = 0.0, strap_width_m = 0.025, label_m = 0.0, flap_deg = 0.0;
     double taper_m = 0.0;
-    std::vector<double> second_dims, second_offset;
+    std::vector<double> second_dims, second_offset, dark_band;
     std::optional<int> intruder_pose;
     bool force = false;
 };
@@ -151,6 +151,10 @@ Result<SyntheticStationConfig> MakeConfig(const SynthOptions& o) {
         c.extra_objects.push_back(second);
     }
     c.intruder_pose = o.intruder_pose;
+    if (!o.dark_band.empty()) {
+        c.dark_from_m = o.dark_band.at(0);
+        c.dark_to_m = o.dark_band.at(1);
+    }
     if (o.distance_m) c.camera_pose.distance_m = *o.distance_m;
     if (o.elevation_deg) c.camera_pose.elevation_deg = *o.elevation_deg;
     if (o.aim_height_m) c.camera_pose.aim_height_m = *o.aim_height_m;
@@ -281,6 +285,10 @@ void AddSynth(CLI::App& app, Runner& run) {
     sub->add_option("--second-offset", o->second_offset, "The second box's centre X Y (m)")
         ->expected(2);
     sub->add_option("--intruder-pose", o->intruder_pose, "A hand reaches in at this pose");
+    sub->add_option("--dark-band", o->dark_band,
+                    "The objects read no depth between these heights (m): a dark or absorbing "
+                    "material")
+        ->expected(2);
     sub->add_flag("--force", o->force, "Write into a non-empty folder that holds no session");
     sub->callback([&run, o] { run = [o] { return RunSynth(*o); }; });
 }

@@ -117,6 +117,7 @@ SyntheticRayHit SyntheticRayCaster::Cast(double u, double v) const {
 
     double best_t = kInf;
     double best_component = 0.0;  // the direction's component along the hit surface's normal
+    bool object = false;
 
     // Box (solid): the slab test in the box frame.
     const double ob[3] = {origin_box_.x(), origin_box_.y(), origin_box_.z()};
@@ -129,12 +130,14 @@ SyntheticRayHit SyntheticRayCaster::Cast(double u, double v) const {
     if (t_box < best_t) {
         best_t = t_box;
         best_component = component;
+        object = true;
     }
     // Mesh objects. The ray parameter is the z-depth here too: `d` is not normalised.
     MeshRayCaster::Hit mesh_hit;
     if (meshes_ && meshes_->Intersect(origin_, d, best_t, mesh_hit) && mesh_hit.t < best_t) {
         best_t = mesh_hit.t;
         best_component = mesh_hit.cos_incidence * d_norm;
+        object = true;
     }
 
     if (d.z() < 0.0) {
@@ -145,12 +148,14 @@ SyntheticRayHit SyntheticRayCaster::Cast(double u, double v) const {
         if (t_top > 0.0 && t_top < best_t && x * x + y * y <= disc_radius_ * disc_radius_) {
             best_t = t_top;
             best_component = d.z();
+            object = false;
         }
         // Floor (z = -floor_drop).
         const double t_floor = (-floor_drop_ - oz) * inv_dz;
         if (t_floor > 0.0 && t_floor < best_t) {
             best_t = t_floor;
             best_component = d.z();
+            object = false;
         }
     }
 
@@ -166,6 +171,7 @@ SyntheticRayHit SyntheticRayCaster::Cast(double u, double v) const {
             best_t = t_rim;
             const double x = ox + t_rim * d.x(), y = oy + t_rim * d.y();
             best_component = (x * d.x() + y * d.y()) / disc_radius_;
+            object = false;
         }
     }
 
@@ -173,6 +179,8 @@ SyntheticRayHit SyntheticRayCaster::Cast(double u, double v) const {
     if (best_t < kInf) {
         hit.z_m = best_t;
         hit.cos_incidence = std::min(1.0, std::abs(best_component) / d_norm);
+        hit.object = object;
+        hit.height_m = oz + best_t * d.z();
     }
     return hit;
 }

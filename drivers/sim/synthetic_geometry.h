@@ -36,6 +36,8 @@ SyntheticBoxPlacement PlaceSyntheticBox(const SyntheticStationConfig& config,
 struct SyntheticRayHit {
     double z_m = 0.0;            // z-depth (along the optical axis); 0 = nothing hit
     double cos_incidence = 1.0;  // |cos| of the angle between the ray and the surface normal
+    bool object = false;         // the hit is on an object standing on the table
+    double height_m = 0.0;       // the hit's height above the table top
 };
 
 // Exact ray caster of the scene at one table angle. Cheap to build; Cast() is thread-safe.

@@ -96,6 +96,10 @@ Status SyntheticStationConfig::Validate() const {
         }
     }
     if (intruder_pose && *intruder_pose < 0) return Bad("intruder_pose", "must be a pose index");
+    if (!Finite(dark_from_m) || !Finite(dark_to_m) || dark_from_m < 0.0 ||
+        dark_to_m < dark_from_m || dark_to_m > 5.0) {
+        return Bad("dark_to_m", "the dark band must lie within 0 <= from <= to <= 5 metres");
+    }
     if (auto st = camera.Validate("camera"); !st) return st;
     if (!Finite(disc_radius_m) || disc_radius_m <= 0.0 || disc_radius_m > 5.0) {
         return Bad("disc_radius_m", "must be in (0, 5] metres");
@@ -245,7 +249,10 @@ DepthImage RenderDepthFrame(const SyntheticScene& scene, double true_angle_rad,
                 v += lateral * rnd::NormalFromLane(normal, bits, 1);
             }
             const SyntheticRayHit hit = caster.Cast(u, v);
-            z[i] = static_cast<float>(hit.z_m);
+            // A dark material returns no depth: the pixel reads nothing (not what lies behind).
+            const bool dark = hit.object && hit.height_m >= cfg.dark_from_m &&
+                              hit.height_m < cfg.dark_to_m;
+            z[i] = dark ? 0.0f : static_cast<float>(hit.z_m);
             cos_inc[i] = static_cast<float>(hit.cos_incidence);
         }
     }

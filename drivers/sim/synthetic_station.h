@@ -99,6 +99,10 @@ struct SyntheticStationConfig {
     std::vector<SyntheticBox> extra_objects;
     // Optional: a hand reaches into the measuring volume in this pose only.
     std::optional<int> intruder_pose;
+    // Material dropout: the objects' surface between these heights above the table is of a
+    // material that returns too little of the sensor's light (matte black, an absorbing tape) and
+    // reads no depth at all. Equal heights: none.
+    double dark_from_m = 0.0, dark_to_m = 0.0;
 
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;

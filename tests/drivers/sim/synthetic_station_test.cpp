@@ -117,6 +117,29 @@ TEST(SyntheticStation, NoiseFreeBoxPixelsLieOnTheBoxFaces) {
     }
 }
 
+// A dark band round the box's foot (matte black, an absorbing tape) reads no depth: no reading of
+// the box between its heights, the box above it as before.
+TEST(SyntheticStation, ADarkBandReadsNoDepth) {
+    SyntheticStationConfig c = ExactStation();
+    c.box = {0.40, 0.25, 0.30, 0.0, 0.0, 20.0};
+    auto count = [](const SyntheticStationConfig& config, double lo, double hi) {
+        const SyntheticScene scene = MakeSyntheticScene(config);
+        int n = 0;
+        for (const Sample& s : BackProject(scene, RenderDepthFrame(scene, 0.0, 1, 0))) {
+            n += s.table.z() >= lo && s.table.z() < hi;
+        }
+        return n;
+    };
+    SyntheticStationConfig dark = c;
+    dark.dark_from_m = 0.0;
+    dark.dark_to_m = 0.05;
+    EXPECT_GT(count(c, 0.005, 0.045), 1000);
+    EXPECT_EQ(count(dark, 0.001, 0.049), 0);
+    EXPECT_EQ(count(dark, 0.06, 0.31), count(c, 0.06, 0.31));  // the box above the band
+    dark.dark_to_m = -1.0;
+    EXPECT_FALSE(dark.Validate().ok());
+}
+
 TEST(SyntheticStation, DiscPixelsLieOnTheTruePlaneThroughTheTrueCentre) {
     SyntheticStationConfig c = ExactStation();
     c.box = {0.2, 0.15, 0.1, 0.0, 0.0, 0.0};
