@@ -83,6 +83,11 @@ float FlyingPixelDepth(const std::vector<float>& z, int w, int h, int x, int y,
     return static_cast<float>(zi + mix * (other - zi));
 }
 
+// Whether the dark band [from, to) lies on the objects' heights (equal: no band).
+bool DarkBandValid(double from, double to) {
+    return Finite(from) && Finite(to) && from >= 0.0 && to >= from && to <= 5.0;
+}
+
 }  // namespace
 
 Status SyntheticStationConfig::Validate() const {
@@ -96,8 +101,7 @@ Status SyntheticStationConfig::Validate() const {
         }
     }
     if (intruder_pose && *intruder_pose < 0) return Bad("intruder_pose", "must be a pose index");
-    if (!Finite(dark_from_m) || !Finite(dark_to_m) || dark_from_m < 0.0 ||
-        dark_to_m < dark_from_m || dark_to_m > 5.0) {
+    if (!DarkBandValid(dark_from_m, dark_to_m)) {
         return Bad("dark_to_m", "the dark band must lie within 0 <= from <= to <= 5 metres");
     }
     if (auto st = camera.Validate("camera"); !st) return st;
