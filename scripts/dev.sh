@@ -145,8 +145,10 @@ fuzz() {
 # its reports to one folder; any report fails the run, whatever the process's exit code was.
 TSAN_DIR=${TSAN_DIR:-build-tsan}
 TSAN_LABELS='^(drivers|drivers/sim|daemon/service)$'
-# Not threads: packaging and a browser (as in the sanitizer run above).
-TSAN_SKIP='DebianPackage[.]|OperatorPage[.]'
+# Not threads: packaging and a browser (as in the sanitizer run above). The OpenNI2 recording
+# test exercises OpenNI2's own recorder (libOniFile, its threads and locks uninstrumented), whose
+# reports change from run to run without a frame of boxd's; the other camera tests stay.
+TSAN_SKIP='DebianPackage[.]|OperatorPage[.]|OpenNi2Camera[.]RecordingOfTheDummyDeviceReadsBack'
 
 tsan() {
     local reports="$PWD/$TSAN_DIR/tsan-reports" status=0
