@@ -16,6 +16,9 @@ double MsSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// What an open answers once Shutdown() has begun.
+Error StoppingError() { return Error{ErrorCode::kShuttingDown, "the daemon is stopping"}; }
+
 JobOutput FailedOutput(ErrorCode code, const std::string& message) {
     JobOutput out;
     out.result.status = MeasurementStatus::kFailed;
@@ -39,7 +42,7 @@ Status DeviceStation::Open() {
         asked_at = opens_finished_;
     }
     std::lock_guard life(lifecycle_mutex_);
-    if (stopping_) return Error{ErrorCode::kShuttingDown, "the daemon is stopping"};
+    if (stopping_) return StoppingError();
     if (open_) return OkStatus();  // another thread opened them while this one waited
     {
         // An open that failed while this caller waited is the answer to its request too (a
@@ -58,7 +61,7 @@ Status DeviceStation::OpenLocked() {
     CloseLocked();  // the devices of a faulted run go first
     Result<StationDevices> devices = OpenStation(config_.station, &stopping_);
     if (!devices) {
-        if (stopping_) return Error{ErrorCode::kShuttingDown, "the daemon is stopping"};
+        if (stopping_) return StoppingError();
         MarkDeviceError(devices.error());
         return devices.error();
     }
@@ -80,7 +83,7 @@ Status DeviceStation::OpenLocked() {
             spdlog::warn("stopping the turntable after a failed open: {}", s.error().message);
         }
         opened->camera->Close();
-        if (stopping_) return Error{ErrorCode::kShuttingDown, "the daemon is stopping"};
+        if (stopping_) return StoppingError();
         MarkDeviceError(homed.error());
         return homed.error();
     }

@@ -88,32 +88,34 @@ Result<std::unique_ptr<SimTurntableProcess>> SimTurntableProcess::Start(
     }
     std::unique_ptr<SimTurntableProcess> process(new SimTurntableProcess(pid, 0));
 
+    const Status listening = process->WaitForPort(port_file, launch);
+    cleanup();
+    if (!listening) return listening.error();
+    spdlog::info("simulated turntable: boxd sim-turntable (pid {}) on 127.0.0.1:{}", pid,
+                 process->port_);
+    return process;
+}
+
+Status SimTurntableProcess::WaitForPort(const fs::path& port_file,
+                                        const SimTurntableLaunch& launch) {
     // The simulator writes the port file once it listens: no race for a free port.
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
     while (std::chrono::steady_clock::now() < deadline) {
         std::ifstream in(port_file);
         if (int bound = 0; in >> bound && bound > 0) {
-            process->port_ = bound;
-            break;
+            port_ = bound;
+            return OkStatus();
         }
         if (launch.cancel != nullptr && launch.cancel->load()) {
-            cleanup();
             return Error{ErrorCode::kAborted, "simulated turntable: its start was abandoned"};
         }
-        if (!process->Running()) {
-            cleanup();
+        if (!Running()) {
             return LaunchError("boxd sim-turntable exited at start (port " +
                                std::to_string(launch.port) + " in use?)");
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
-    cleanup();
-    if (process->port_ <= 0) {
-        return LaunchError("boxd sim-turntable did not start listening within 10 s");
-    }
-    spdlog::info("simulated turntable: boxd sim-turntable (pid {}) on 127.0.0.1:{}", pid,
-                 process->port_);
-    return process;
+    return LaunchError("boxd sim-turntable did not start listening within 10 s");
 }
 
 bool SimTurntableProcess::Reaped() {

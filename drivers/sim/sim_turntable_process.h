@@ -48,6 +48,9 @@ public:
 
 private:
     SimTurntableProcess(pid_t pid, int port) : pid_(pid), port_(port) {}
+    // Waits (10 s at most) for the child to write the port it listens on into `port_file`;
+    // TURNTABLE_ERROR when it exits or times out, ABORTED when launch.cancel is set.
+    Status WaitForPort(const std::filesystem::path& port_file, const SimTurntableLaunch& launch);
     // Returns true when the child has exited (recording its exit code), without waiting.
     bool Reaped();
 

@@ -88,18 +88,24 @@ bool DarkBandValid(double from, double to) {
     return Finite(from) && Finite(to) && from >= 0.0 && to >= from && to <= 5.0;
 }
 
+// Returns an error naming the first extra object that is no shape or leaves the disc.
+Status ValidateExtraObjects(const std::vector<SyntheticBox>& objects, double disc_radius_m) {
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+        const std::string field = "extra_objects[" + std::to_string(i) + "]";
+        if (auto st = ValidateSyntheticObject(objects[i], field); !st) return st;
+        if (SyntheticObjectReach(objects[i]) > disc_radius_m) {
+            return Bad(field, "reaches beyond the disc radius");
+        }
+    }
+    return OkStatus();
+}
+
 }  // namespace
 
 Status SyntheticStationConfig::Validate() const {
     const SyntheticBox& b = box;
     if (auto st = ValidateSyntheticObject(b, "box"); !st) return st;
-    for (std::size_t i = 0; i < extra_objects.size(); ++i) {
-        const std::string field = "extra_objects[" + std::to_string(i) + "]";
-        if (auto st = ValidateSyntheticObject(extra_objects[i], field); !st) return st;
-        if (SyntheticObjectReach(extra_objects[i]) > disc_radius_m) {
-            return Bad(field, "reaches beyond the disc radius");
-        }
-    }
+    if (auto st = ValidateExtraObjects(extra_objects, disc_radius_m); !st) return st;
     if (intruder_pose && *intruder_pose < 0) return Bad("intruder_pose", "must be a pose index");
     if (!DarkBandValid(dark_from_m, dark_to_m)) {
         return Bad("dark_to_m", "the dark band must lie within 0 <= from <= to <= 5 metres");
