@@ -122,7 +122,7 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     // The subsamples of the surface above the table: what the support function and a grazing
     // top's height read, and what the shape's figures (fill, top cover) read.
     const envelope::Surface surface = envelope::SurfaceAbove(cloud, config.max_points, config);
-    const envelope::Surface shape = envelope::SurfaceAbove(cloud, config.shape_points, config);
+    const envelope::Surface shape = envelope::SurfaceAbove(cloud, config.shape_points, config, false);
     // Where no view saw a top (the box fit found too few readings on one), the top's cells hold
     // walls' ends only, spread up the walls with their rays' vertical share of the noise (a
     // fifth of the table's at a grazing top). A top some view saw has rims beside it, read with

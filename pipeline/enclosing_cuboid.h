@@ -30,11 +30,14 @@
 //   - the foot band (the readings within min_z_m of the table are the table's): a wall sloping
 //     outward is extended down to the table at its slope, the extension's own uncertainty and
 //     the bend of its profile in the bound; an upright wall stays where it is (foot_band.h);
+//   - a wall's foot that nothing read (a dark or glossy base, a shadow): the table's readings
+//     beside the object bound how far it may go, the wall's extrapolation is held within that
+//     and the bound reaches it; with no table reading beyond, refused (foot_free_space.h);
 //   - a side no view faced: refused (support_envelope.cpp), or for one view assumed and tested
 //     (single_view_cuboid.h);
 //   - a top no view saw from above: the walls' ends, with their noise (HeightNoiseSigma).
-// Not yet carried: depth missing next to the silhouette (a dark band, a projector shadow) is
-// read as free space.
+// Not yet carried: a single view's foot (single_view_cuboid.h reads no table beside it), and
+// missing depth higher up a wall (the support reads the wall's readings above and below it).
 
 #include <Eigen/Core>
 #include <array>

@@ -83,16 +83,36 @@ std::optional<PolyFit> FitRows(const std::vector<RowReach>& rows, int degree) {
     return out;
 }
 
+// Whether the rows between the band and row `first` hold fewer readings than one judged cell:
+// nothing read the wall there (a few strays aside), rather than too few readings to judge a
+// cell (the narrow foot of a lying tube's round end).
+bool NothingReadBelow(const CellGrid<LayerCell>& layer, int first, const EnvelopeConfig& config) {
+    long readings = 0;
+    for (int j = 0; j < first; ++j) {
+        if (layer.b0 + (j + 1) * layer.db <= config.min_z_m + 1e-9) continue;  // within the band
+        for (int i = 0; i < layer.na; ++i) {
+            readings += layer.cells[static_cast<std::size_t>(j) * layer.na + i].n;
+        }
+    }
+    return readings < config.min_cell_points;
+}
+
 }  // namespace
 
 FootReach ExtrapolateFoot(const CellGrid<LayerCell>& layer, const EnvelopeConfig& config) {
-    // The lowest row holding a judged cell must be the first above the band: a wall whose lowest
-    // readings stand higher (an overhang, a part resting on another) has no foot here.
+    FootReach out;
+    // The lowest row holding a judged cell: the first above the band, or higher where nothing
+    // read the wall's foot (foot_free_space.h says how far it may go).
     int first = -1;
     for (int j = 0; j < layer.nb && first < 0; ++j) {
         if (OutermostInRow(layer, j, config)) first = j;
     }
-    if (first < 0 || layer.b0 + first * layer.db > config.min_z_m + 1e-9) return {};
+    if (first < 0) return out;
+    // A wall read below its lowest judged row, too sparsely to judge (the narrow foot of a lying
+    // tube's round end), or standing on something (an overhang), has no foot to extend.
+    const bool at_band = layer.b0 + first * layer.db <= config.min_z_m + 1e-9;
+    out.raised = !at_band && NothingReadBelow(layer, first, config);
+    if (!at_band && !out.raised) return out;
     // The wall's profile: its lowest rows, one after another, as far as kProfileRows.
     std::vector<RowReach> rows;
     for (int j = first; j < layer.nb && j < first + kProfileRows; ++j) {
@@ -100,16 +120,15 @@ FootReach ExtrapolateFoot(const CellGrid<LayerCell>& layer, const EnvelopeConfig
         if (!r) break;
         rows.push_back(*r);
     }
-    if (rows.size() < 3) return {};
+    if (rows.size() < 3) return out;
     const auto line = FitRows(rows, 1);
     // The profile above its lowest row must slope outward too: one row standing out alone is no
     // flank (a silhouette's few stray readings beside an upright tube at its foot).
     const auto upper = FitRows(std::vector<RowReach>(rows.begin() + 1, rows.end()), 1);
     if (!line || !upper || !(line->slope > kSlopeSigmas * line->slope_se) ||
         !(upper->slope > kSlopeSigmas * upper->slope_se)) {
-        return {};
+        return out;
     }
-    FootReach out;
     out.slope = line->slope;
     out.reach = line->at_table;
     double variance = line->at_table_se * line->at_table_se;

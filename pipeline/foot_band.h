@@ -19,12 +19,15 @@ struct FootReach {
     double reach = -INFINITY;  // where the wall meets the table (along the layer's direction)
     double se = 0.0;           // its standard error
     double slope = 0.0;        // the wall's outward run per metre of height, going down
+    // The wall's lowest readings stand a row or more above the band: nothing read its foot
+    // (a dark or glossy base, a shadow), and the reach is extrapolated from higher up.
+    bool raised = false;
 };
 
 // Returns the foot of the outer layer `layer` (cells of (across, up), up from the table top, as
-// support_envelope.cpp builds them): -INFINITY when the wall does not reach down to the band,
-// or does not slope outward beyond its noise there (an upright or undercut wall stays where its
-// readings are).
+// support_envelope.cpp builds them), extrapolated from its lowest rows (raised where those stand
+// above the band): -INFINITY when the wall does not slope outward beyond its noise there (an
+// upright or undercut wall stays where its readings are).
 FootReach ExtrapolateFoot(const CellGrid<LayerCell>& layer, const EnvelopeConfig& config);
 
 }  // namespace boxd::envelope

@@ -70,6 +70,15 @@ FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& p
     return out;
 }
 
+Points FuseTableReadings(const std::vector<Points>& table, const std::vector<Se2>& poses) {
+    Points out;
+    for (std::size_t k = 0; k < table.size() && k < poses.size(); ++k) {
+        const Se2Map move(poses[k]);
+        for (const Eigen::Vector3f& p : table[k]) out.push_back(move(p));
+    }
+    return out;
+}
+
 ConsistencyReport CheckViewConsistency(const FusedCloud& cloud, int num_views, const BoxFit& box,
                                        const FusionConfig& config) {
     ConsistencyReport report;

@@ -41,6 +41,10 @@ struct FusedCloud {
     // Each view's camera in this frame, where the views' own frame gave one (else empty): the
     // face fits read a reading's margins along its ray (box_fit.h, ReadingRays).
     std::vector<Eigen::Vector3f> cameras;
+    // The table top's readings beside the object (SegmentedView::table_points), moved like the
+    // views, and whether they were gathered at all (foot_free_space.h).
+    Points table;
+    bool table_known = false;
 };
 
 struct ConsistencyReport {
@@ -55,6 +59,9 @@ struct ConsistencyReport {
 FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& poses,
                      const FusionConfig& config,
                      const std::optional<Eigen::Vector3f>& camera = std::nullopt);
+
+// Returns the table readings of the views (`table`, per view, its own frame) moved by `poses`.
+Points FuseTableReadings(const std::vector<Points>& table, const std::vector<Se2>& poses);
 
 // Returns, per view, whether its points agree with the fitted box.
 ConsistencyReport CheckViewConsistency(const FusedCloud& cloud, int num_views, const BoxFit& box,

@@ -79,6 +79,15 @@ double Confidence(const RegisteredViews& registered, int poses, double face_sigm
            std::min(1.0, static_cast<double>(points) / static_cast<double>(c.full_points));
 }
 
+// Moves the views' table readings beside the object into `fused` like the views (several views:
+// a single view's foot is the single-view cuboid's concern, single_view_cuboid.h).
+void AddTableReadings(ObjectViews& views, const std::vector<Se2>& poses, FusedCloud* fused) {
+    std::vector<Points> table(views.views.size());
+    for (std::size_t k = 0; k < table.size(); ++k) table[k] = std::move(views.views[k].table_points);
+    fused->table = FuseTableReadings(table, poses);
+    fused->table_known = true;
+}
+
 // Stages 4b to 7 on the views and edges of `stream`.
 MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const MeasureConfig& config,
                            BoxMethod method, const MonotonicMs& clock) {
@@ -112,6 +121,7 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
     FusedFit fit = FuseAndFit(view_points, registered->poses, config.fusion, config.box_fit,
                               &m.laps, table.camera_to_table.translation().cast<float>());
     quality.points = static_cast<long>(fit.fused.points.size());
+    if (n > 1) AddTableReadings(views, registered->poses, &fit.fused);
     if (auto why = CheckSingleObject(fit.fused, refuse)) {
         m.out.cloud = std::move(fit.fused.points);
         return m.Refused(*why);

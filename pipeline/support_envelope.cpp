@@ -8,8 +8,10 @@
 #include <utility>
 
 #include "pipeline/foot_band.h"
+#include "pipeline/foot_free_space.h"
 #include "pipeline/layer_marks.h"
 #include "pipeline/parallel_for.h"
+#include "pipeline/student_t.h"
 #include "pipeline/surface_cells.h"
 
 namespace boxd::envelope {
@@ -24,11 +26,20 @@ namespace {
 // 140 degrees by 28% (24% under another registration tried): a quarter left that to chance.
 constexpr double kUnseenShare = 0.1;
 
+// A table reading may land this many of its spreads inside the table's true edge by its noise
+// (TableReadingSpread): the free space beside a foot is taken to begin that much farther out.
+// FreeReach reads a strip's third nearest reading: three of the few readings at the edge all
+// landing 1.5 spreads inside it is a chance of a few in a thousand, and the widest of the
+// wall's strips counts.
+constexpr double kTableSpreadSigmas = 1.5;
+
 // The outer layer's largest bound in direction (cos φ, sin φ) and in the opposite one, over
 // cells of (position across the direction, height).
 struct Support {
     double forward = -INFINITY, backward = -INFINITY;
     double se_forward = 0.0, se_backward = 0.0;
+    // A foot nothing read, and no table reading beside it bounds (foot_free_space.h).
+    bool open_forward = false, open_backward = false;
     double Width() const { return forward + backward; }
     double WidthSe() const { return std::hypot(se_forward, se_backward); }
 };
@@ -84,6 +95,39 @@ std::vector<Layers> BuildLayers(const std::vector<Eigen::Vector3f>& pts, const E
     return out;
 }
 
+// Below the lowest row (`foot`, along `u`): a wall sloping outward goes on to the table
+// (foot_band.h). Where nothing read the foot (its lowest readings stand above the band), the
+// table's readings beside the object bound how far it may go (foot_free_space.h): the
+// extrapolation is held within that, and the 95% bound reaches that limit (the object may
+// continue into what nothing read, up to where the table was seen) as well as covering the
+// extrapolation's own error; with no table readings beyond, the foot is open. Without the
+// table's readings (`table` null) a raised foot stays where its readings are.
+void ReachBelow(const FootReach& foot, const std::vector<Eigen::Vector3f>& pts,
+                const Eigen::Vector2d& u, const TableBeside* table, double& reach, double& se,
+                bool& open) {
+    if (!foot.raised) {
+        if (foot.reach > reach) {
+            reach = foot.reach;
+            se = foot.se;
+        }
+        return;
+    }
+    if (table == nullptr) return;
+    const double free = FreeReach(*table, pts, u);
+    if (!std::isfinite(free)) {
+        open = true;
+        return;
+    }
+    // The readings hold the reach from below and the table from above; within that, a wall
+    // sloping outward goes on sloping. The bound reaches the table's limit, and below as far as
+    // the extrapolation's own error or the readings, whichever is nearer.
+    const double read = reach;
+    if (free <= read) return;
+    reach = std::clamp(foot.reach, read, free);
+    const double below = std::min(reach - read, kNormal95 * foot.se);
+    se = std::max(se, std::max(free - reach, below) / kNormal95);
+}
+
 // Leaves out of `coarse` (cells twice the size each way, on the same origin) every cell that
 // holds a judged cell of `fine`: there the small cells have had their say.
 void KeepGapsOnly(const CellGrid<LayerCell>& fine, CellGrid<LayerCell>& coarse,
@@ -115,7 +159,8 @@ void KeepGapsOnly(const CellGrid<LayerCell>& fine, CellGrid<LayerCell>& coarse,
 // LargestBound's `caps`); the half rows only catch what stands out of a row, and the largest of
 // two noisy readings of one crest would stand above it.
 Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double sigma,
-                     double radius, double top, const EnvelopeConfig& config) {
+                     double radius, double top, const EnvelopeConfig& config,
+                     const TableBeside* table) {
     const Eigen::Vector2d u(std::cos(phi), std::sin(phi));
     const double along = config.cell_along_m, height = config.cell_height_m;
     std::vector<Layers> layers =
@@ -145,13 +190,10 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
         farther(fine, std::max(along, height), forward, true, true);
         farther(coarse, 2.0 * std::max(along, height), forward, false, false);
         farther(thin, std::max(along, height / 2.0), forward, true, false);
-        // Below the lowest row: a wall sloping outward goes on to the table (foot_band.h).
-        const FootReach foot = ExtrapolateFoot(forward ? fine.front : fine.back, config);
-        double& best = forward ? out.forward : out.backward;
-        if (foot.reach > best) {
-            best = foot.reach;
-            (forward ? out.se_forward : out.se_backward) = foot.se;
-        }
+        ReachBelow(ExtrapolateFoot(forward ? fine.front : fine.back, config), pts,
+                   forward ? u : Eigen::Vector2d(-u), table, forward ? out.forward : out.backward,
+                   forward ? out.se_forward : out.se_backward,
+                   forward ? out.open_forward : out.open_backward);
     }
     return out;
 }
@@ -256,6 +298,9 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
     const std::vector<Eigen::Vector3f>& pts = surface.points;
     if (pts.empty()) return Error{ErrorCode::kInsufficientData, "no surface above the table"};
     const double radius = surface.radius, top = surface.top;
+    TableBeside table{&surface.table, kTableSpreadSigmas * TableReadingSpread(sigma, surface.cameras),
+                      config.cell_along_m / 4.0, radius};
+    const TableBeside* beside = surface.table_known ? &table : nullptr;
     // A side no view faced has no facing surface: its "support" would be whatever faces that
     // way farther in (the far side's inside, a panel's back), well inside the readings of the
     // top or the other sides that reach out there. Such a direction bounds nothing. Where a view
@@ -275,7 +320,7 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
             });
     };
     auto width = [&](double phi, Support* s, char* unseen) -> double {
-        *s = SupportAlong(pts, phi, sigma, radius, top, config);
+        *s = SupportAlong(pts, phi, sigma, radius, top, config, beside);
         const Eigen::Vector2f u(static_cast<float>(std::cos(phi)),
                                 static_cast<float>(std::sin(phi)));
         double reach_f = -INFINITY, reach_b = -INFINITY;
@@ -346,6 +391,13 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
     if (!std::isfinite(best_area)) {
         return Error{ErrorCode::kInsufficientData,
                      "a side of the object was never seen: too few views around it to bound it"};
+    }
+    if (su.open_forward || su.open_backward || sv.open_forward || sv.open_backward) {
+        return Error{ErrorCode::kInsufficientData,
+                     "nothing was read at the foot of a side of the object, nor on the table "
+                     "beside it: how far it reaches there is unknown (a dark or glossy base, or "
+                     "a shadow; a matte label round the base, a lighter table top or a second "
+                     "camera angle helps)"};
     }
     EnclosingCuboid c;
     const Eigen::Vector2d u(std::cos(best_phi), std::sin(best_phi)), v(-u.y(), u.x());

@@ -208,7 +208,8 @@ double HeightNoiseSigma(double table_sigma_m, const Eigen::Vector3d& camera_m, d
     return table_sigma_m * std::min(1.0, vertical_share(z_m) / table);
 }
 
-Surface SurfaceAbove(const FusedCloud& cloud, int max_points, const EnvelopeConfig& config) {
+Surface SurfaceAbove(const FusedCloud& cloud, int max_points, const EnvelopeConfig& config,
+                     bool with_table) {
     Surface out;
     std::size_t above = 0;
     for (const Eigen::Vector3f& p : cloud.points) above += p.z() >= config.min_z_m ? 1 : 0;
@@ -223,6 +224,10 @@ Surface SurfaceAbove(const FusedCloud& cloud, int max_points, const EnvelopeConf
     out.radius += 0.01;
     out.top += 0.01;
     out.cameras = cloud.cameras;
+    if (!with_table) return out;
+    out.table_known = cloud.table_known;
+    out.table.reserve(cloud.table.size());
+    for (const Eigen::Vector3f& p : cloud.table) out.table.push_back(p.head<2>());
     return out;
 }
 

@@ -142,9 +142,16 @@ struct Surface {
     std::vector<Eigen::Vector3f> points;
     double radius = 0.0, top = 0.0;
     std::vector<Eigen::Vector3f> cameras;  // the views' cameras (FusedCloud::cameras), or none
+    // The table top's readings beside the object (FusedCloud::table, x and y), and whether they
+    // were gathered (foot_free_space.h).
+    std::vector<Eigen::Vector2f> table;
+    bool table_known = false;
 };
 
-Surface SurfaceAbove(const FusedCloud& cloud, int max_points, const EnvelopeConfig& config);
+// Returns an even subsample of at most `max_points` of the cloud's readings above the table,
+// with the views' cameras and, where `with_table`, the table's readings beside the object.
+Surface SurfaceAbove(const FusedCloud& cloud, int max_points, const EnvelopeConfig& config,
+                     bool with_table = true);
 
 // Returns the noise of a reading's height at `z_m` above the table's centre, from the noise of
 // the table top about its plane (`table_sigma_m`) and the camera's position (table frame). A

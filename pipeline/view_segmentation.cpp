@@ -23,6 +23,56 @@ int BlockPick(int view, int bu, int bv, int stride) {
     return static_cast<int>(MixBits(key) % static_cast<std::uint64_t>(stride * stride));
 }
 
+// Returns the readings of `table` within about `margin` (on the table plane, by square cells of
+// a twelfth of it) of a reading of `object`, all within `radius` of the axis: the object's cells
+// are marked, the marks widened by the margin each way, and a table reading kept in a marked
+// cell.
+Points TableBesideObject(const Points& table, const Points& object, double margin, double radius) {
+    Points out;
+    if (object.empty() || !(margin > 0.0)) return out;
+    constexpr int kCellsPerMargin = 12;
+    const double cell = margin / kCellsPerMargin;
+    const int n = 2 * static_cast<int>(std::ceil(radius / cell)) + 1;
+    const double origin = -cell * (n / 2) - cell / 2;
+    auto index = [&](const Eigen::Vector3f& p) -> long {
+        const int i = static_cast<int>(std::floor((p.x() - origin) / cell));
+        const int j = static_cast<int>(std::floor((p.y() - origin) / cell));
+        if (i < 0 || j < 0 || i >= n || j >= n) return -1;
+        return static_cast<long>(j) * n + i;
+    };
+    std::vector<char> mark(static_cast<std::size_t>(n) * n, 0);
+    for (const Eigen::Vector3f& p : object) {
+        if (const long k = index(p); k >= 0) mark[static_cast<std::size_t>(k)] = 1;
+    }
+    // The square dilation, one axis after the other (a running count of marks in the window).
+    auto dilate = [&](bool rows) {
+        std::vector<char> in = mark;
+        for (int a = 0; a < n; ++a) {
+            int count = 0;
+            auto at = [&](int b) -> char& {
+                return rows ? in[static_cast<std::size_t>(a) * n + b]
+                            : in[static_cast<std::size_t>(b) * n + a];
+            };
+            auto out_at = [&](int b) -> char& {
+                return rows ? mark[static_cast<std::size_t>(a) * n + b]
+                            : mark[static_cast<std::size_t>(b) * n + a];
+            };
+            for (int b = 0; b < kCellsPerMargin && b < n; ++b) count += at(b);
+            for (int b = 0; b < n; ++b) {
+                if (b + kCellsPerMargin < n) count += at(b + kCellsPerMargin);
+                if (b - kCellsPerMargin - 1 >= 0) count -= at(b - kCellsPerMargin - 1);
+                out_at(b) = count > 0 ? 1 : 0;
+            }
+        }
+    };
+    dilate(true);
+    dilate(false);
+    for (const Eigen::Vector3f& p : table) {
+        if (const long k = index(p); k >= 0 && mark[static_cast<std::size_t>(k)]) out.push_back(p);
+    }
+    return out;
+}
+
 }  // namespace
 
 Status SegmentationConfig::Validate() const {
@@ -37,6 +87,9 @@ Status SegmentationConfig::Validate() const {
     }
     if (fusion_pixel_stride < 1 || fusion_pixel_stride > 8) {
         return Bad("fusion_pixel_stride", "must be in 1..8");
+    }
+    if (!(table_margin_m >= 0.0 && table_margin_m <= 0.5)) {
+        return Bad("table_margin_m", "must be in [0, 0.5]");
     }
     return OkStatus();
 }
@@ -61,6 +114,8 @@ SegmentedView SegmentView(const DepthMap& depth, const CameraIntrinsics& camera,
     // The pixel BlockPick draws in each block of the current row of blocks.
     const int stride = config.fusion_pixel_stride;
     std::vector<int> picks(static_cast<std::size_t>(depth.width / stride + 1));
+    Points table;  // the table top's readings in the measuring volume
+    table.reserve(static_cast<std::size_t>(depth.width) * depth.height);
     for (int v = 0; v < depth.height; ++v) {
         if (v % stride == 0) {
             for (std::size_t b = 0; b < picks.size(); ++b)
@@ -74,8 +129,9 @@ SegmentedView SegmentView(const DepthMap& depth, const CameraIntrinsics& camera,
             const float z = static_cast<float>(calibration.CorrectDepth(raw));
             const float rx = (static_cast<float>(u) - static_cast<float>(camera.cx)) * inv_fx;
             const Eigen::Vector3f p = rot * Eigen::Vector3f(rx * z, ry * z, z) + trans;
-            if (p.z() < zmin || p.z() > zmax) continue;
             const float r2 = p.x() * p.x() + p.y() * p.y();
+            if (p.z() < zmin && p.z() > -zmin && r2 <= r_in2) table.push_back(p);
+            if (p.z() < zmin || p.z() > zmax) continue;
             if (r2 > r_in2) {
                 if (r2 <= r_out2) ++view.outside_points;
                 continue;
@@ -90,6 +146,8 @@ SegmentedView SegmentView(const DepthMap& depth, const CameraIntrinsics& camera,
             }
         }
     }
+    view.table_points = TableBesideObject(table, view.points, config.table_margin_m,
+                                          config.cylinder_radius_m);
     return view;
 }
 

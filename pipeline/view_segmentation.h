@@ -29,6 +29,10 @@ struct SegmentationConfig {
     // seeing it at the same depths. A noise-free 0.25 x 0.18 x 0.12 m box in 1 mm units read
     // 0.04 mm tall on the grid, 0.02 mm drawn, 0.01 mm at every pixel.
     int fusion_pixel_stride = 3;
+    // The table top's own readings within this distance of the object's (on the table plane)
+    // are kept: where nothing read an object's foot, they are what proves it ends
+    // (foot_free_space.h). A foot reaching farther from its lowest readings is not bounded.
+    double table_margin_m = 0.06;
 
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;
@@ -40,6 +44,9 @@ struct SegmentedView {
     int border_points = 0;   // object points within border_margin_px of the image border
     int outside_points = 0;  // readings above the table just outside the cylinder
     int valid_pixels = 0;    // pixels with a reading in the averaged map
+    // Readings of the table top (within min_height_m of its plane) within table_margin_m of the
+    // object's readings, table frame: the rays that reached the table beside the object.
+    Points table_points;
 };
 
 // Returns the object points of `depth` in the table frame given by `camera_to_table`, with the

@@ -233,6 +233,7 @@ std::optional<MeasurementReason> ViewStream::Complete() {
             for (SegmentedView& v : views_.views) {
                 for (Eigen::Vector3f& p : v.fusion_points) p = move * p;
                 for (Eigen::Vector3f& p : v.points) p = move * p;
+                for (Eigen::Vector3f& p : v.table_points) p = move * p;
             }
             table_error_.reset();
         }

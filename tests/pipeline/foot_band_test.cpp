@@ -1,7 +1,8 @@
 // Known-answer tests of the foot band (pipeline/foot_band.h): a wall's outer layer read from the
 // band's top up, as the support function bins it, and where the extension puts the wall's foot
 // on the table — a flank sloping outward (a prism's, a frustum's), an upright wall, an undercut
-// one, a wall that starts high above the table, and a bending profile, over several seeds.
+// one, a wall nothing read near the table (raised) or read too sparsely there, and a bending
+// profile, over several seeds.
 #include "pipeline/foot_band.h"
 
 #include <gtest/gtest.h>
@@ -69,12 +70,38 @@ TEST(FootBand, ALowestRowStandingOutAloneIsNotExtended) {
         std::isfinite(ExtrapolateFoot(Layer(stray, config.min_z_m, 0.2, 1, config), config).reach));
 }
 
-TEST(FootBand, AWallWhoseReadingsStartHighHasNoFootHere) {
+// Nothing read below 50 mm (a dark base): the wall is extended from its lowest rows and marked
+// raised, for the table's readings beside it to bound (foot_free_space.h).
+TEST(FootBand, AWallNothingReadBelowIsExtendedAndMarkedRaised) {
     const EnvelopeConfig config;
-    // An overhang: the wall's lowest readings 50 mm up, sloping outward below that.
-    auto overhang = [](double z) { return 0.1 - 0.5 * z; };
-    EXPECT_FALSE(
-        std::isfinite(ExtrapolateFoot(Layer(overhang, 0.05, 0.2, 1, config), config).reach));
+    auto flank = [](double z) { return 0.1 - 0.5 * z; };
+    for (unsigned seed = 1; seed <= 5; ++seed) {
+        const FootReach foot = ExtrapolateFoot(Layer(flank, 0.05, 0.2, seed, config), config);
+        EXPECT_TRUE(foot.raised) << "seed " << seed;
+        ASSERT_TRUE(std::isfinite(foot.reach)) << "seed " << seed;
+        EXPECT_LT(std::abs(foot.reach - 0.1), 2.0 * foot.se + 1e-4) << "seed " << seed;
+    }
+    // An upright wall read from 50 mm up is raised too, with nothing to extend.
+    const FootReach upright =
+        ExtrapolateFoot(Layer([](double) { return 0.2; }, 0.05, 0.2, 1, config), config);
+    EXPECT_TRUE(upright.raised);
+    EXPECT_FALSE(std::isfinite(upright.reach));
+}
+
+// Read below its lowest judged row, but too sparsely to judge a cell there (a lying tube's
+// round end narrowing to the table): no foot to extend, and not raised.
+TEST(FootBand, AWallReadTooSparselyBelowHasNoFoot) {
+    const EnvelopeConfig config;
+    auto flank = [](double z) { return 0.1 - 0.5 * z; };
+    CellGrid<LayerCell> layer = Layer(flank, 0.05, 0.2, 1, config);
+    int added = 0;
+    for (double z = config.min_z_m; z < 0.048; z += 0.0015, ++added) {
+        if (LayerCell* c = layer.At(0.0, z)) c->Add3(0.0, z, flank(z));
+    }
+    ASSERT_GE(added, config.min_cell_points);
+    const FootReach foot = ExtrapolateFoot(layer, config);
+    EXPECT_FALSE(foot.raised);
+    EXPECT_FALSE(std::isfinite(foot.reach));
 }
 
 TEST(FootBand, ABendingFootWidensTheBound) {

@@ -181,12 +181,50 @@ TEST(SegmentView, CountsReadingsJustOutsideTheCylinder) {
     EXPECT_EQ(view.border_points, 0);
 }
 
+// The table's readings beside the object are kept (the free space that bounds a foot nothing
+// read, foot_free_space.h); those farther than table_margin_m, and the bumps above the band, not.
+TEST(SegmentView, KeepsTheTableReadingsBesideTheObject) {
+    const CameraIntrinsics cam = SmallCamera();
+    DepthMap depth = Table(cam);
+    Raise(depth, 28, 36, 20, 28, 0.1);  // a small box: 0.9 m away, 18 mm a pixel at the table
+    SegmentationConfig config = SmallVolume();
+    config.table_margin_m = 0.05;
+    const SegmentedView view = SegmentView(depth, cam, StationCalibration{}, LookingDown(), config, 0);
+    ASSERT_EQ(view.points.size(), 64u);
+    ASSERT_FALSE(view.table_points.empty());
+    float box_x0 = INFINITY, box_x1 = -INFINITY;
+    for (const Eigen::Vector3f& p : view.points) {
+        box_x0 = std::min(box_x0, p.x());
+        box_x1 = std::max(box_x1, p.x());
+    }
+    int beside = 0;
+    for (const Eigen::Vector3f& p : view.table_points) {
+        EXPECT_NEAR(p.z(), 0.0, 1e-5);
+        // Within the margin (by cells of a twelfth of it) of a box reading.
+        EXPECT_LT(p.x(), box_x1 + 0.05 + 0.05 / 6.0);
+        EXPECT_GT(p.x(), box_x0 - 0.05 - 0.05 / 6.0);
+        beside += p.x() > box_x1 && p.x() < box_x1 + 0.03;
+    }
+    EXPECT_GT(beside, 0);
+    // The far table is left out: fewer readings than the bare table's.
+    EXPECT_LT(view.table_points.size(), 64u * 48u / 2u);
+    // No margin: none kept.
+    config.table_margin_m = 0.0;
+    EXPECT_TRUE(
+        SegmentView(depth, cam, StationCalibration{}, LookingDown(), config, 0).table_points.empty());
+}
+
 TEST(SegmentationConfig, ValidateNamesField) {
     SegmentationConfig c;
     c.max_height_m = c.min_height_m;
     const Status s = c.Validate();
     ASSERT_FALSE(s.ok());
     EXPECT_NE(s.error().message.find("max_height_m"), std::string::npos);
+    SegmentationConfig margin;
+    margin.table_margin_m = -0.01;
+    const Status m = margin.Validate();
+    ASSERT_FALSE(m.ok());
+    EXPECT_NE(m.error().message.find("table_margin_m"), std::string::npos);
 }
 
 }  // namespace

@@ -1,0 +1,72 @@
+#include "pipeline/foot_free_space.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+namespace boxd::envelope {
+
+namespace {
+
+// The table readings a strip needs beyond the object: the nearest two may be strays (a mixed
+// pixel at the silhouette, a reading landed far inside by its noise).
+constexpr int kNearest = 3;
+
+// One strip across the direction: the object's outermost reading in it and the nearest table
+// readings beyond that.
+struct Strip {
+    double object = -INFINITY;
+    std::array<double, kNearest> table{INFINITY, INFINITY, INFINITY};
+
+    void AddTable(double s) {
+        if (s >= table.back()) return;
+        table.back() = s;
+        std::sort(table.begin(), table.end());
+    }
+};
+
+}  // namespace
+
+double TableReadingSpread(double sigma_m, const std::vector<Eigen::Vector3f>& cameras) {
+    double lowest = INFINITY;  // the smallest tan(elevation) of a ray from a camera to the axis
+    for (const Eigen::Vector3f& c : cameras) {
+        const double across = c.head<2>().cast<double>().norm();
+        if (across > 0.0) lowest = std::min(lowest, static_cast<double>(c.z()) / across);
+    }
+    // A camera looking along the table top sees its readings' noise all along it.
+    if (!std::isfinite(lowest) || lowest < 0.05) return sigma_m / 0.05;
+    return sigma_m / lowest;
+}
+
+double FreeReach(const TableBeside& table, const std::vector<Eigen::Vector3f>& object,
+                 const Eigen::Vector2d& u) {
+    if (table.points == nullptr || object.empty()) return INFINITY;
+    const Eigen::Vector2f uf = u.cast<float>(), vf(-uf.y(), uf.x());
+    const double inv = 1.0 / table.strip_m;
+    const long half = static_cast<long>(std::ceil(table.radius_m * inv)) + 1;
+    std::vector<Strip> strips(static_cast<std::size_t>(2 * half + 1));
+    auto strip = [&](const Eigen::Vector2f& q) -> Strip* {
+        const long k = static_cast<long>(std::floor(vf.dot(q) * inv)) + half;
+        if (k < 0 || k >= static_cast<long>(strips.size())) return nullptr;
+        return &strips[static_cast<std::size_t>(k)];
+    };
+    for (const Eigen::Vector3f& p : object) {
+        if (Strip* s = strip(p.head<2>())) {
+            s->object = std::max(s->object, static_cast<double>(uf.dot(p.head<2>())));
+        }
+    }
+    for (const Eigen::Vector2f& q : *table.points) {
+        Strip* s = strip(q);
+        if (s == nullptr || !std::isfinite(s->object)) continue;
+        const double along = uf.dot(q);
+        if (along > s->object - table.tolerance_m) s->AddTable(along);
+    }
+    double reach = -INFINITY;
+    for (const Strip& s : strips) {
+        if (std::isfinite(s.object)) reach = std::max(reach, s.table.back());
+    }
+    return reach + table.tolerance_m;
+}
+
+}  // namespace boxd::envelope
