@@ -47,6 +47,10 @@ struct SynthOptions {
     double strap_m = 0.0, strap_width_m = 0.025, label_m = 0.0, flap_deg = 0.0;
     double taper_m = 0.0;
     std::vector<double> second_dims, second_offset, dark_band;
+    // The effects of real cameras (sensor_effects.h) on top of the noise model.
+    std::optional<double> shadow_baseline_m, correlated_noise_m, correlation_px;
+    std::optional<double> fixed_pattern_m, fixed_pattern_px;
+    std::optional<int> edge_fattening_px;
     std::optional<int> intruder_pose;
     bool force = false;
 };
@@ -117,6 +121,22 @@ void RemoveStaleFrames(const fs::path& dir, const std::vector<fs::path>& previou
     }
 }
 
+// Returns the noise model's parameters with the effects asked for, or none when none is.
+std::optional<SensorNoiseParams> SensorEffects(const SynthOptions& o, NoiseModel model) {
+    if (!o.shadow_baseline_m && !o.edge_fattening_px && !o.correlated_noise_m &&
+        !o.fixed_pattern_m) {
+        return std::nullopt;
+    }
+    SensorNoiseParams p = DefaultSensorNoise(model);
+    if (o.shadow_baseline_m) p.shadow_baseline_m = *o.shadow_baseline_m;
+    if (o.edge_fattening_px) p.edge_fattening_px = *o.edge_fattening_px;
+    if (o.correlated_noise_m) p.correlated_sigma_m = *o.correlated_noise_m;
+    if (o.correlation_px) p.correlation_px = *o.correlation_px;
+    if (o.fixed_pattern_m) p.fixed_pattern_m = *o.fixed_pattern_m;
+    if (o.fixed_pattern_px) p.fixed_pattern_px = *o.fixed_pattern_px;
+    return p;
+}
+
 Result<SyntheticStationConfig> MakeConfig(const SynthOptions& o) {
     SyntheticStationConfig c;
     c.box.length_m = o.dims.at(0);
@@ -161,6 +181,7 @@ Result<SyntheticStationConfig> MakeConfig(const SynthOptions& o) {
     auto noise = ParseNoiseModel(o.noise);
     if (!noise) return noise.error();
     c.noise = *noise;
+    c.sensor_noise = SensorEffects(o, *noise);
     c.seed = o.seed;
     if (o.angle_error_deg) c.angle_error_deg = *o.angle_error_deg;
     if (o.calib_center_error_m) c.calib_center_error_m = *o.calib_center_error_m;
@@ -228,6 +249,22 @@ int RunSynth(const SynthOptions& o) {
     return kExitOk;
 }
 
+void AddSensorEffectOptions(CLI::App* sub, SynthOptions& o) {
+    sub->add_option("--shadow-baseline-m", o.shadow_baseline_m,
+                    "A second viewpoint this far along the camera's x axis (negative: -x) must "
+                    "see a point too: a projector's or a second imager's shadows (m)");
+    sub->add_option("--edge-fattening-px", o.edge_fattening_px,
+                    "Nearer surfaces read this many pixels wider along x at depth edges");
+    sub->add_option("--correlated-noise-m", o.correlated_noise_m,
+                    "Smooth noise drawn every frame: sigma at 1 m (m), growing as depth^2");
+    sub->add_option("--correlation-px", o.correlation_px,
+                    "Spacing of the correlated noise's knots (pixels, default 16)");
+    sub->add_option("--fixed-pattern-m", o.fixed_pattern_m,
+                    "A bias pattern the same in every frame: sigma at 1 m (m), growing as depth^2");
+    sub->add_option("--fixed-pattern-px", o.fixed_pattern_px,
+                    "Spacing of the fixed pattern's knots (pixels, default 64)");
+}
+
 }  // namespace
 
 void AddSynth(CLI::App& app, Runner& run) {
@@ -289,6 +326,7 @@ void AddSynth(CLI::App& app, Runner& run) {
                     "The objects read no depth between these heights (m): a dark or absorbing "
                     "material")
         ->expected(2);
+    AddSensorEffectOptions(sub, *o);
     sub->add_flag("--force", o->force, "Write into a non-empty folder that holds no session");
     sub->callback([&run, o] { run = [o] { return RunSynth(*o); }; });
 }

@@ -47,6 +47,14 @@ Status SensorNoiseParams::Validate(const std::string& where) const {
     if (std::isnan(max_range_m) || max_range_m <= min_range_m) {
         return bad("max_range_m", "must be greater than min_range_m");
     }
+    if (!in(shadow_baseline_m, -1.0, 1.0)) return bad("shadow_baseline_m", "must be in -1..1");
+    if (edge_fattening_px < 0 || edge_fattening_px > 20) {
+        return bad("edge_fattening_px", "must be in 0..20");
+    }
+    if (!in(correlated_sigma_m, 0.0, 0.1)) return bad("correlated_sigma_m", "must be in 0..0.1");
+    if (!in(correlation_px, 2.0, 1000.0)) return bad("correlation_px", "must be in 2..1000");
+    if (!in(fixed_pattern_m, 0.0, 0.1)) return bad("fixed_pattern_m", "must be in 0..0.1");
+    if (!in(fixed_pattern_px, 2.0, 1000.0)) return bad("fixed_pattern_px", "must be in 2..1000");
     return OkStatus();
 }
 

@@ -35,6 +35,20 @@ struct SensorNoiseParams {
     double dropout_full_deg = 90.0;         // ...and where no reading is left
     double min_range_m = 0.0;               // readings outside [min, max] are dropped
     double max_range_m = std::numeric_limits<double>::infinity();
+    // The effects of real cameras beyond the noise models (sensor_effects.h); off by default.
+    // A second viewpoint this far along the camera's x axis (negative: towards -x) that must see
+    // a point too: a structured-light projector, or a stereo camera's second imager (0: none).
+    double shadow_baseline_m = 0.0;
+    // Edge fattening: a pixel within this many pixels along x of a nearer surface reads its depth.
+    int edge_fattening_px = 0;
+    // Spatially correlated noise, drawn afresh every frame: a smooth field whose knots, every
+    // correlation_px pixels, have this sigma at 1 m (growing as z^2, as disparity errors do).
+    double correlated_sigma_m = 0.0;
+    double correlation_px = 16.0;
+    // A fixed-pattern bias: a smooth field, knots every fixed_pattern_px pixels with this sigma at
+    // 1 m, the same in every frame of a session.
+    double fixed_pattern_m = 0.0;
+    double fixed_pattern_px = 64.0;
 
     // Returns an error naming the first invalid field (prefixed with `where`), or Ok.
     Status Validate(const std::string& where = "sensor_noise") const;

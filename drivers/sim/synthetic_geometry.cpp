@@ -87,6 +87,7 @@ SyntheticRayCaster::SyntheticRayCaster(const SyntheticStationConfig& config, dou
     camera_to_table_ = frame.table_to_camera.transpose();
     origin_ = frame.position_m;
     const SyntheticBoxPlacement place = PlaceSyntheticBox(config, table_angle_rad, pose_index);
+    box_center_ = place.center_m;
     box_cos_ = std::cos(place.yaw_rad);
     box_sin_ = std::sin(place.yaw_rad);
     const Eigen::Vector3d rel(origin_.x() - place.center_m.x(), origin_.y() - place.center_m.y(),
@@ -181,8 +182,31 @@ SyntheticRayHit SyntheticRayCaster::Cast(double u, double v) const {
         hit.cos_incidence = std::min(1.0, std::abs(best_component) / d_norm);
         hit.object = object;
         hit.height_m = oz + best_t * d.z();
+        hit.point = origin_ + best_t * d;
     }
     return hit;
+}
+
+bool SyntheticRayCaster::Blocked(const Eigen::Vector3d& from, const Eigen::Vector3d& to,
+                                 double margin_m) const {
+    const Eigen::Vector3d d = to - from;
+    const double length = d.norm();
+    if (!(length > margin_m)) return false;
+    const double t_max = 1.0 - margin_m / length;  // the segment runs over t in (0, 1)
+    if (ideal_box_) {
+        const Eigen::Vector3d rel(from.x() - box_center_.x(), from.y() - box_center_.y(),
+                                  from.z());
+        const double ob[3] = {box_cos_ * rel.x() + box_sin_ * rel.y(),
+                              -box_sin_ * rel.x() + box_cos_ * rel.y(), rel.z()};
+        const double db[3] = {box_cos_ * d.x() + box_sin_ * d.y(),
+                              -box_sin_ * d.x() + box_cos_ * d.y(), d.z()};
+        const double lo[3] = {-box_half_.x(), -box_half_.y(), 0.0};
+        const double hi[3] = {box_half_.x(), box_half_.y(), 2.0 * box_half_.z()};
+        double component = 0.0;
+        if (IntersectBox(ob, db, lo, hi, component) < t_max) return true;
+    }
+    MeshRayCaster::Hit hit;
+    return meshes_ && meshes_->Intersect(from, d, t_max, hit) && hit.t < t_max;
 }
 
 }  // namespace boxd

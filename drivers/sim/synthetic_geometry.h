@@ -38,6 +38,7 @@ struct SyntheticRayHit {
     double cos_incidence = 1.0;  // |cos| of the angle between the ray and the surface normal
     bool object = false;         // the hit is on an object standing on the table
     double height_m = 0.0;       // the hit's height above the table top
+    Eigen::Vector3d point = Eigen::Vector3d::Zero();  // the hit, table frame
 };
 
 // Exact ray caster of the scene at one table angle. Cheap to build; Cast() is thread-safe.
@@ -50,12 +51,21 @@ public:
     // integers, as in the intrinsics).
     SyntheticRayHit Cast(double u, double v) const;
 
+    // Returns whether an object stands between `from` and `to` (table frame; `to` itself and the
+    // last `margin_m` before it excluded, so a surface point does not block itself).
+    bool Blocked(const Eigen::Vector3d& from, const Eigen::Vector3d& to, double margin_m) const;
+
+    // The camera centre, and its x axis (the baseline's direction), table frame.
+    const Eigen::Vector3d& Origin() const { return origin_; }
+    Eigen::Vector3d CameraX() const { return camera_to_table_.col(0); }
+
 private:
     CameraIntrinsics camera_;
     double inv_fx_ = 1.0, inv_fy_ = 1.0;
     Eigen::Matrix3d camera_to_table_;       // columns: camera axes in table coordinates
     Eigen::Vector3d origin_;                // camera centre, table frame
     Eigen::Vector3d origin_box_;            // camera centre, box frame
+    Eigen::Vector2d box_center_;            // the box's centre on the table, table frame
     double box_cos_ = 1.0, box_sin_ = 0.0;  // table -> box frame rotation about z
     Eigen::Vector3d to_box_center_;         // camera centre -> box centre, table frame
     double box_radius_sq_ = 0.0;            // squared radius of the box's bounding sphere

@@ -28,15 +28,8 @@ enum Stream : std::uint64_t {
     kStreamFrames = 1,
     kStreamAngleError = 2,
     kStreamCalibration = 3,
+    // 4: the fixed pattern (render_depth_frame.cpp)
 };
-// Sub-streams of a frame seed, one per artefact.
-enum FrameStream : std::uint64_t {
-    kPixel = 1,
-    kDropout = 4,
-    kFlying = 5,
-    kFlyingMix = 6,
-};
-
 Error Bad(const std::string& field, const std::string& why) {
     return {ErrorCode::kInvalidInput, field + ": " + why};
 }
@@ -52,35 +45,6 @@ Eigen::Vector3d RandomUnitVector(std::uint64_t seed, std::uint64_t index) {
         const Eigen::Vector3d v(a, b, c);
         if (v.norm() > 1e-6) return v.normalized();
     }
-}
-
-// Returns the depth of pixel `i` mixed towards its most different neighbour when that neighbour
-// lies across a depth jump: the mixed ("flying") pixels that structured-light and stereo sensors
-// produce at object edges, where the matching window straddles two surfaces.
-float FlyingPixelDepth(const std::vector<float>& z, int w, int h, int x, int y,
-                       const SensorNoiseParams& noise, std::uint64_t seed) {
-    const std::size_t i = static_cast<std::size_t>(y) * w + x;
-    const float zi = z[i];
-    float other = 0.0f;
-    float best_jump = static_cast<float>(noise.flying_pixel_min_jump_m);
-    auto consider = [&](int nx, int ny) {
-        if (nx < 0 || ny < 0 || nx >= w || ny >= h) return;
-        const float zn = z[static_cast<std::size_t>(ny) * w + nx];
-        if (zn <= 0.0f) return;
-        const float jump = std::abs(zn - zi);
-        if (jump >= best_jump) {
-            best_jump = jump;
-            other = zn;
-        }
-    };
-    consider(x - 1, y);
-    consider(x + 1, y);
-    consider(x, y - 1);
-    consider(x, y + 1);
-    if (other <= 0.0f) return zi;
-    if (rnd::Uniform(rnd::Derive(seed, kFlying), i) >= noise.flying_pixel_probability) return zi;
-    const double mix = rnd::Uniform(rnd::Derive(seed, kFlyingMix), i);
-    return static_cast<float>(zi + mix * (other - zi));
 }
 
 // Whether the dark band [from, to) lies on the objects' heights (equal: no band).
@@ -231,87 +195,6 @@ SyntheticScene MakeSyntheticScene(const SyntheticStationConfig& config) {
     recorded.focal_scale = 1.0;  // the station trusts the factory intrinsics
     scene.recorded_calibration = recorded;
     return scene;
-}
-
-DepthImage RenderDepthFrame(const SyntheticScene& scene, double true_angle_rad,
-                            std::uint64_t frame_seed, int pose_index) {
-    const SyntheticStationConfig& cfg = scene.config;
-    const CameraIntrinsics& cam = cfg.camera;
-    const SensorNoiseParams& noise = scene.noise;
-    const int w = cam.width, h = cam.height;
-    const SyntheticRayCaster caster(cfg, true_angle_rad, pose_index);
-    const rnd::NormalQuantileTable& normal = rnd::NormalQuantiles();
-    // One 64-bit draw per pixel gives its lateral jitter (lanes 0, 1), its axial noise (lane 2)
-    // and its hole lottery (lane 3); the rarer artefacts draw from their own streams.
-    const std::uint64_t pixel_seed = rnd::Derive(frame_seed, kPixel);
-
-    // Pass 1: what each (laterally jittered) pixel ray sees.
-    const std::size_t n = static_cast<std::size_t>(w) * h;
-    std::vector<float> z(n, 0.0f), cos_inc(n, 1.0f);
-    const double lateral = noise.lateral_sigma_px;
-    for (int y = 0; y < h; ++y) {
-        for (int x = 0; x < w; ++x) {
-            const std::size_t i = static_cast<std::size_t>(y) * w + x;
-            double u = x, v = y;
-            if (lateral > 0.0) {
-                const std::uint64_t bits = rnd::Bits(pixel_seed, i);
-                u += lateral * rnd::NormalFromLane(normal, bits, 0);
-                v += lateral * rnd::NormalFromLane(normal, bits, 1);
-            }
-            const SyntheticRayHit hit = caster.Cast(u, v);
-            // A dark material returns no depth: the pixel reads nothing (not what lies behind).
-            const bool dark = hit.object && hit.height_m >= cfg.dark_from_m &&
-                              hit.height_m < cfg.dark_to_m;
-            z[i] = dark ? 0.0f : static_cast<float>(hit.z_m);
-            cos_inc[i] = static_cast<float>(hit.cos_incidence);
-        }
-    }
-
-    // Pass 2: the sensor's artefacts, then the 16-bit encoding.
-    DepthImage img(w, h);
-    const std::uint64_t dropout_seed = rnd::Derive(frame_seed, kDropout);
-    const double cos_dropout_start = std::cos(noise.dropout_start_deg * kDegToRad);
-    const double dropout_span = noise.dropout_full_deg - noise.dropout_start_deg;
-    const bool noisy_axis = noise.axial != NoiseModel::kNone;
-    const bool needs_angle = noise.axial == NoiseModel::kKinect;  // its sigma depends on incidence
-    const double focal_px = 0.5 * (cam.fx + cam.fy);
-    const double hole_threshold = noise.hole_fraction * 65536.0;
-    const double inverse_unit = 1.0 / cam.depth_unit_m;
-    const KinectDepthTable& kinect_levels = KinectDisparityDepths();
-    for (int y = 0; y < h; ++y) {
-        for (int x = 0; x < w; ++x) {
-            const std::size_t i = static_cast<std::size_t>(y) * w + x;
-            if (z[i] <= 0.0f) continue;
-            const std::uint64_t bits = rnd::Bits(pixel_seed, i);
-            if (rnd::Lane16(bits, 3) < hole_threshold) continue;
-            const double cos_i = cos_inc[i];
-            const double incidence =
-                needs_angle || cos_i < cos_dropout_start ? std::acos(cos_i) : 0.0;
-            if (cos_i < cos_dropout_start) {
-                const double incidence_deg = incidence / kDegToRad;
-                const double p = dropout_span > 0.0
-                                     ? (incidence_deg - noise.dropout_start_deg) / dropout_span
-                                     : 1.0;
-                if (rnd::Uniform(dropout_seed, i) < p) continue;
-            }
-            double depth = z[i];
-            if (noise.flying_pixel_probability > 0.0) {
-                depth = FlyingPixelDepth(z, w, h, x, y, noise, frame_seed);
-            }
-            if (noisy_axis) {
-                const double sigma = AxialSigma(noise, depth, incidence, focal_px);
-                depth += sigma * rnd::NormalFromLane(normal, bits, 2);
-            }
-            depth -= cfg.true_depth_offset_m;  // the sensor's bias: it reads short by the offset
-            if (noise.disparity_quantisation) depth = KinectQuantiseDepth(depth, kinect_levels);
-            if (depth <= 0.0 || depth < noise.min_range_m || depth > noise.max_range_m) continue;
-            const double units = std::nearbyint(depth * inverse_unit);
-            // Beyond the 16-bit range there is no reading rather than a wrong one.
-            if (units > 65535.0) continue;
-            img.pixels[i] = static_cast<std::uint16_t>(std::max(1.0, units));
-        }
-    }
-    return img;
 }
 
 Result<Session> RenderSyntheticSession(const SyntheticStationConfig& config, int poses,

@@ -126,6 +126,10 @@ TEST(CliSynth, BadArgumentsExitTwoWithOneLine) {
         {"--dims", "0.3", "0.2", "0.2", "--depth-unit-m", "0"},
         {"--dims", "0.3", "0.2", "0.2", "--depth-unit-m", "0.1"},
         {"--poses", "4"},
+        {"--dims", "0.3", "0.2", "0.2", "--shadow-baseline-m", "2"},
+        {"--dims", "0.3", "0.2", "0.2", "--edge-fattening-px", "-1"},
+        {"--dims", "0.3", "0.2", "0.2", "--fixed-pattern-m", "0.5"},
+        {"--dims", "0.3", "0.2", "0.2", "--correlated-noise-m", "0.001", "--correlation-px", "1"},
     };
     for (const auto& c : cases) {
         const auto r = RunBoxd(Synth(dir / "s", c));
@@ -141,6 +145,8 @@ TEST(CliSynth, BadArgumentsExitTwoWithOneLine) {
     EXPECT_NE(r.err.find("length"), std::string::npos) << r.err;
     const auto n = RunBoxd(Synth(dir / "s", {"--dims", "0.3", "0.2", "0.2", "--noise", "foo"}));
     EXPECT_NE(n.err.find("foo"), std::string::npos) << n.err;
+    const auto b = RunBoxd(Synth(dir / "s", {"--dims", "0.3", "0.2", "0.2", "--shadow-baseline-m", "2"}));
+    EXPECT_NE(b.err.find("shadow_baseline_m"), std::string::npos) << b.err;
 }
 
 TEST(CliSynth, KeepsUserDataAndReplacesOnlyAPreviousSyntheticSession) {
