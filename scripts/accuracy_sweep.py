@@ -27,6 +27,10 @@ on stations drawn as for the parcels; each kind is reported per sensor. For ever
 summary counts confident wrong numbers: a dimension whose true error is larger than twice its
 reported 95% bound plus 1 mm.
 
+With --effects each object also gets one effect of real cameras drawn evenly (a dark foot,
+a projector's or second imager's shadows, fattened edges, correlated noise, a fixed pattern, or
+none), and the summary adds each effect's line.
+
 With --one-pose each object is seen from one pose only (the cuboid assumption: within 5 mm and
 its bounds, or refused).
 
@@ -37,7 +41,7 @@ wide).
 
 Usage: scripts/accuracy_sweep.py [--boxd build/daemon/boxd]
                                  [--objects boxes|parcels|small|few|pairs|shapes]
-                                 [--seed 1] [--count 60] [--jobs 2] [--one-pose]
+                                 [--seed 1] [--count 60] [--jobs 2] [--one-pose] [--effects]
 Exit status 1 when a measured object is off by more than --fail-above-mm (default 1.0 for
 boxes, 3.0 for parcels, 2.0 for small cartons, 5.0 for few poses and one pose) in any dimension, or no case
 could be measured, or one is refused NO_OBJECT; for pairs, when any pair is measured or refused with another code;
@@ -157,6 +161,29 @@ def draw_shape(rng, index, seed):
     return {"name": f"h{seed}_{index}", "kind": f"{kind} {noise}", "args": [*station, *features]}
 
 
+EFFECTS = ("none", "dark foot", "shadow", "fattening", "correlated", "fixed pattern")
+
+
+def draw_effect(rng, case):
+    """Adds one effect of real cameras, drawn evenly (README, sensor effects), to `case`:
+    a base reading no depth 10-40 mm up, the shadows of a projector (Kinect, 75 mm either side)
+    or a second imager (RealSense, 50 mm to the right), edges fattened 1-4 pixels, correlated
+    noise of 0.5-2 mm, or a fixed pattern of 0.5-3 mm (both at 1 m)."""
+    effect = EFFECTS[rng.randrange(len(EFFECTS))]
+    kinect = case["args"][case["args"].index("--noise") + 1] == "kinect"
+    case["args"] += {
+        "none": lambda: [],
+        "dark foot": lambda: ["--dark-band", "0", f"{rng.uniform(0.01, 0.04):.3f}"],
+        "shadow": lambda: ["--shadow-baseline-m",
+                           f"{rng.choice([-0.075, 0.075]) if kinect else 0.05:.3f}"],
+        "fattening": lambda: ["--edge-fattening-px", str(rng.randint(1, 4))],
+        "correlated": lambda: ["--correlated-noise-m", f"{rng.uniform(0.0005, 0.002):.4f}"],
+        "fixed pattern": lambda: ["--fixed-pattern-m", f"{rng.uniform(0.0005, 0.003):.4f}"],
+    }[effect]()
+    case["effect"] = effect
+    return case
+
+
 def confidently_wrong(error_mm, bound_mm):
     """A number a carrier would bill by that is wrong by more than its bound says it could be."""
     return abs(error_mm) > 2.0 * bound_mm + 1.0
@@ -261,6 +288,8 @@ def main():
     parser.add_argument("--fail-above-mm", type=float)
     parser.add_argument("--one-pose", action="store_true",
                         help="see each object from one pose only, at an angle drawn from SEED")
+    parser.add_argument("--effects", action="store_true",
+                        help="add one effect of real cameras to each object, drawn from SEED")
     args = parser.parse_args()
     if args.fail_above_mm is None:
         args.fail_above_mm = 5.0 if args.one_pose else {
@@ -273,6 +302,8 @@ def main():
     if args.one_pose:
         for case in cases:
             case["args"] += ["--angles", str(rng.randrange(360))]
+    if args.effects:
+        cases = [draw_effect(rng, case) for case in cases]
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         outcomes = list(pool.map(lambda c: run_case(args.boxd, c), cases))
 
@@ -283,7 +314,7 @@ def main():
                   f"{' x '.join(f'{d:.1f}' for d in o['dimensions_mm'])} mm  {' '.join(o['args'])}")
         elif "error_mm" in o:
             cells = " ".join(f"{e:+6.2f} ({b:4.2f})" for e, b in zip(o["error_mm"], o["bound_mm"]))
-            print(f"{o['name']:10s} {cells}  {o['shape']:9s} {o.get('kind', 'box'):10s} "
+            print(f"{o['name']:10s} {cells}  {o['shape']:9s} {o.get('kind', 'box'):10s} {o.get('effect', ''):13s} "
                   f"{' '.join(o['args'])}")
         else:
             print(f"{o['name']:10s} {o['status']} {o.get('reason', '')}  {' '.join(o['args'])}")
@@ -318,6 +349,8 @@ def main():
     print(f"confident wrong numbers (|error| > 2 x bound + 1 mm): {wrong} of {len(pairs)}")
     for kind in sorted({o["kind"] for o in outcomes if "kind" in o}):
         print("  " + kind_line(kind, [o for o in outcomes if o.get("kind") == kind]))
+    for effect in sorted({o["effect"] for o in outcomes if "effect" in o}):
+        print("  " + kind_line(effect, [o for o in outcomes if o.get("effect") == effect]))
     worst = max(e for e, _ in pairs)
     blind = any(o.get("reason") == "NO_OBJECT" for o in outcomes)  # every case shows an object
     if args.objects == "shapes":
