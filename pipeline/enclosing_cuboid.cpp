@@ -108,6 +108,9 @@ Status EnvelopeConfig::Validate() const {
     if (!(max_incidence_deg > 0.0 && max_incidence_deg < 90.0)) {
         return bad("max_incidence_deg", "must be in (0, 90)");
     }
+    if (!(narrowest_kept_m >= 0.0 && narrowest_kept_m < 0.1)) {
+        return bad("narrowest_kept_m", "must be in [0, 0.1)");
+    }
     return OkStatus();
 }
 

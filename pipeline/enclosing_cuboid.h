@@ -71,6 +71,9 @@ struct EnvelopeConfig {
     int shape_points = 40000;
     double layer_sigmas = 5.0;  // a cell's outer layer: within this many σ of its extreme
     double min_z_m = 0.012;     // points lower than this are table, not footprint
+    // The narrowest part the fusion keeps (FusionConfig::support_voxel_m, which the recipe
+    // copies here): a sharp apex narrower than this may have no reading left (peak_reach.h).
+    double narrowest_kept_m = 0.006;
     // Shape: the convex hull of a cuboid's footprint fills its rectangle to at least min_fill
     // (an L missing a quarter fills 7/8, a tube pi/4; rounded edges of a tenth of the side lose
     // a hundredth), and no face stands out of its plane by more than max_relative_excess of the

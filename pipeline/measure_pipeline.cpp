@@ -128,9 +128,11 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
     }
 
     // 7. The smallest enclosing cuboid of the outermost surface, and the shape.
+    EnvelopeConfig envelope = config.envelope;
+    envelope.narrowest_kept_m = config.fusion.support_voxel_m;
     const auto cuboid = FitEnclosingCuboid(fit.fused, fit.box, n, registered->edges.mean_rmse_m,
                                            table.residual_sigma_m,
-                                           table.camera_to_table.translation(), config.envelope);
+                                           table.camera_to_table.translation(), envelope);
     m.laps.Lap("fit");
     std::array<double, 3> uncertainty{};
     if (cuboid) {

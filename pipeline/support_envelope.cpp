@@ -1,6 +1,7 @@
 #include "pipeline/support_envelope.h"
 
 #include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <array>
@@ -11,6 +12,7 @@
 #include "pipeline/foot_free_space.h"
 #include "pipeline/layer_marks.h"
 #include "pipeline/parallel_for.h"
+#include "pipeline/peak_reach.h"
 #include "pipeline/student_t.h"
 #include "pipeline/surface_cells.h"
 
@@ -267,6 +269,27 @@ Alike AlikeRectangles(const std::vector<Support>& supports, int best) {
     return {count, sum_u / count, sum_v / count};
 }
 
+// A sharp peak or ridge thins the top's cells out below it (peak_reach.h): its highest
+// readings hold the height where they stand above the cells' `height`, and the apex may stand
+// above them by the flanks' slope times the readings' spacing; read halfway, the bound `se`
+// reaching both ends. `height_sigma`: a reading's noise in its height.
+void ReadSharpTop(const Surface& surface, double height_sigma, const EnvelopeConfig& config,
+                  double* height, double* se) {
+    const PeakReach peak = ExtrapolatePeak(surface.points, surface.view, height_sigma,
+                                           2.0 * config.cell_height_m, config.cell_along_m,
+                                           config.narrowest_kept_m);
+    if (!peak.sharp) return;
+    spdlog::debug("envelope: a sharp top, its highest readings {:.2f} mm above the cells', slope "
+                  "{:.2f}, spacing {:.2f} mm",
+                  (peak.highest - *height) * 1e3, peak.slope, peak.spacing * 1e3);
+    if (peak.highest > *height) {
+        *height = peak.highest;
+        *se = height_sigma;
+    }
+    *height += peak.above / 2.0;
+    *se = std::hypot(*se, peak.above / 2.0 / kNormal95);
+}
+
 }  // namespace
 
 double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double height_sigma,
@@ -409,6 +432,7 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
     c.length_axis = lu >= lv ? u : v;
     double se_top = 0.0;
     c.height_m = TopBound(pts, sigma, height_sigma, radius, config, &se_top);
+    ReadSharpTop(surface, height_sigma, config, &c.height_m, &se_top);
     const double s_u = su.WidthSe();
     const double s_v = sv.WidthSe();
     c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u, se_top};

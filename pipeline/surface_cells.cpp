@@ -215,9 +215,11 @@ Surface SurfaceAbove(const FusedCloud& cloud, int max_points, const EnvelopeConf
     for (const Eigen::Vector3f& p : cloud.points) above += p.z() >= config.min_z_m ? 1 : 0;
     const std::size_t step = std::max<std::size_t>(1, above / static_cast<std::size_t>(max_points));
     std::size_t k = 0;
-    for (const Eigen::Vector3f& p : cloud.points) {
+    for (std::size_t i = 0; i < cloud.points.size(); ++i) {
+        const Eigen::Vector3f& p = cloud.points[i];
         if (p.z() < config.min_z_m || (k++ % step) != 0) continue;
         out.points.push_back(p);
+        if (i < cloud.view.size()) out.view.push_back(cloud.view[i]);
         out.radius = std::max(out.radius, static_cast<double>(p.head<2>().norm()));
         out.top = std::max(out.top, static_cast<double>(p.z()));
     }

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <utility>
 #include <vector>
@@ -140,6 +141,7 @@ struct CellGrid {
 // from the axis and up, with a centimetre to spare.
 struct Surface {
     std::vector<Eigen::Vector3f> points;
+    std::vector<std::uint16_t> view;  // each point's view (FusedCloud::view), where known
     double radius = 0.0, top = 0.0;
     std::vector<Eigen::Vector3f> cameras;  // the views' cameras (FusedCloud::cameras), or none
     // The table top's readings beside the object (FusedCloud::table, x and y), and whether they

@@ -1,0 +1,91 @@
+// Known-answer tests of a sharp top (pipeline/peak_reach.h): a pyramid whose last millimetres no
+// view read, a prism's ridge, and tops that are not sharp — a flat top, a bag's gentle crown, an
+// upright panel's edge — each read by 18 views on their own jittered 2 mm grids with 1 mm of
+// noise in height.
+#include "pipeline/peak_reach.h"
+
+#include <gtest/gtest.h>
+
+#include <functional>
+#include <random>
+#include <vector>
+
+namespace boxd::envelope {
+namespace {
+
+constexpr double kNoise = 0.001;
+constexpr int kViews = 18;
+constexpr double kGrid = 0.002;  // a view's readings about a metre away, 1 in 9 of its pixels kept
+
+struct Cloud {
+    std::vector<Eigen::Vector3f> points;
+    std::vector<std::uint16_t> view;
+};
+
+// The surface z = `height(x, y)` over [-half, half]^2 (NaN: no surface), read where it stands
+// above `read_below` no higher than `cut` (the part above the cut read by no view).
+Cloud Sample(const std::function<double(double, double)>& height, double half, double cut,
+             unsigned seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, kNoise);
+    std::uniform_real_distribution<double> jitter(0.0, kGrid);
+    Cloud c;
+    for (int v = 0; v < kViews; ++v) {
+        const double jx = jitter(rng), jy = jitter(rng);
+        for (double x = -half + jx; x < half; x += kGrid) {
+            for (double y = -half + jy; y < half; y += kGrid) {
+                const double z = height(x, y);
+                if (!std::isfinite(z) || z > cut || z < 0.012) continue;
+                c.points.emplace_back(static_cast<float>(x), static_cast<float>(y),
+                                      static_cast<float>(z + noise(rng)));
+                c.view.push_back(static_cast<std::uint16_t>(v));
+            }
+        }
+    }
+    return c;
+}
+
+// The envelope's figures: a 24 mm band, 12 mm narrow, 6 mm the narrowest part kept.
+PeakReach Peak(const Cloud& c) {
+    return ExtrapolatePeak(c.points, c.view, kNoise, 0.024, 0.012, 0.006);
+}
+
+TEST(PeakReach, APyramidsUnreadApexIsWithinTheBound) {
+    // 200 x 120 mm base, 300 mm tall: flanks rising 3 and 5 per metre; its last 6 mm unread.
+    auto pyramid = [](double x, double y) {
+        return 0.3 * std::min(1.0 - std::abs(x) / 0.1, 1.0 - std::abs(y) / 0.06);
+    };
+    for (unsigned seed = 1; seed <= 5; ++seed) {
+        const PeakReach p = Peak(Sample(pyramid, 0.1, 0.294, seed));
+        ASSERT_TRUE(p.sharp) << "seed " << seed;
+        EXPECT_NEAR(p.highest, 0.294, 0.002) << "seed " << seed;
+        EXPECT_GT(p.slope, 2.0) << "seed " << seed;
+        // The bound reaches the apex: the readings' height plus all it may stand above them.
+        EXPECT_GT(p.highest + p.above, 0.3 - 0.001) << "seed " << seed;
+        EXPECT_LT(p.above, 0.03) << "seed " << seed;
+    }
+}
+
+TEST(PeakReach, APrismsRidgeIsSharp) {
+    // A prism lying along x: 120 mm base, 104 mm tall (flanks rising 1.73 per metre).
+    auto prism = [](double, double y) { return 0.104 * (1.0 - std::abs(y) / 0.06); };
+    const PeakReach p = Peak(Sample(prism, 0.06, 0.102, 1));
+    ASSERT_TRUE(p.sharp);
+    EXPECT_NEAR(p.slope, 1.73, 0.5);
+    EXPECT_GT(p.highest + p.above, 0.104 - 0.001);
+}
+
+TEST(PeakReach, FlatTopsGentleCrownsAndPanelEdgesAreNotSharp) {
+    auto flat = [](double, double) { return 0.2; };
+    auto crown = [](double x, double y) { return 0.2 - (x * x + y * y) / (2.0 * 0.1); };
+    // An upright panel 4 mm thick, 200 mm tall, along x.
+    auto panel = [](double, double y) { return std::abs(y) <= 0.002 ? 0.2 : NAN; };
+    for (unsigned seed = 1; seed <= 3; ++seed) {
+        EXPECT_FALSE(Peak(Sample(flat, 0.1, 1.0, seed)).sharp) << "seed " << seed;
+        EXPECT_FALSE(Peak(Sample(crown, 0.1, 1.0, seed)).sharp) << "seed " << seed;
+        EXPECT_FALSE(Peak(Sample(panel, 0.1, 1.0, seed)).sharp) << "seed " << seed;
+    }
+}
+
+}  // namespace
+}  // namespace boxd::envelope
