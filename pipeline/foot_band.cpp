@@ -41,8 +41,8 @@ std::optional<RowReach> OutermostInRow(const CellGrid<LayerCell>& layer, int row
         contenders += c.n >= config.min_cell_points &&
                       c.Mean() >= best->Mean() - 2.0 * (c.StdError() + best->StdError());
     }
-    return RowReach{best->Mean() - MedianOfLargest(contenders) * best->StdError(),
-                    best->StdError(), best->Centroid().y()};
+    return RowReach{best->Mean() - MedianOfLargest(contenders) * best->StdError(), best->StdError(),
+                    best->Centroid().y()};
 }
 
 // A weighted least-squares polynomial through rows (z, s, se): its value and standard error at

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <vector>
 
+#include "pipeline/student_t.h"
+
 namespace boxd::envelope {
 
 namespace {
@@ -67,6 +69,32 @@ double FreeReach(const TableBeside& table, const std::vector<Eigen::Vector3f>& o
         if (std::isfinite(s.object)) reach = std::max(reach, s.table.back());
     }
     return reach + table.tolerance_m;
+}
+
+void ReachBelow(const FootReach& foot, const std::vector<Eigen::Vector3f>& pts,
+                const Eigen::Vector2d& u, const TableBeside* table, double& reach, double& se,
+                bool& open) {
+    if (!foot.raised) {
+        if (foot.reach > reach) {
+            reach = foot.reach;
+            se = foot.se;
+        }
+        return;
+    }
+    if (table == nullptr) return;
+    const double free = FreeReach(*table, pts, u);
+    if (!std::isfinite(free)) {
+        open = true;
+        return;
+    }
+    // The readings hold the reach from below and the table from above; within that, a wall
+    // sloping outward goes on sloping. The bound reaches the table's limit, and below as far as
+    // the extrapolation's own error or the readings, whichever is nearer.
+    const double read = reach;
+    if (free <= read) return;
+    reach = std::clamp(foot.reach, read, free);
+    const double below = std::min(reach - read, kNormal95 * foot.se);
+    se = std::max(se, std::max(free - reach, below) / kNormal95);
 }
 
 }  // namespace boxd::envelope

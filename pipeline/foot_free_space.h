@@ -13,6 +13,8 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "pipeline/foot_band.h"
+
 namespace boxd::envelope {
 
 struct TableBeside {
@@ -37,5 +39,16 @@ double TableReadingSpread(double sigma_m, const std::vector<Eigen::Vector3f>& ca
 // readings beyond it: nothing there proves the object ends.
 double FreeReach(const TableBeside& table, const std::vector<Eigen::Vector3f>& object,
                  const Eigen::Vector2d& u);
+
+// Below the lowest row (`foot`, along `u`): a wall sloping outward goes on to the table
+// (foot_band.h). Where nothing read the foot (its lowest readings stand above the band), the
+// table's readings beside the object bound how far it may go (foot_free_space.h): the
+// extrapolation is held within that, and the 95% bound reaches that limit (the object may
+// continue into what nothing read, up to where the table was seen) as well as covering the
+// extrapolation's own error; with no table readings beyond, the foot is open. Without the
+// table's readings (`table` null) a raised foot stays where its readings are.
+void ReachBelow(const FootReach& foot, const std::vector<Eigen::Vector3f>& pts,
+                const Eigen::Vector2d& u, const TableBeside* table, double& reach, double& se,
+                bool& open);
 
 }  // namespace boxd::envelope

@@ -83,7 +83,8 @@ double Confidence(const RegisteredViews& registered, int poses, double face_sigm
 // a single view's foot is the single-view cuboid's concern, single_view_cuboid.h).
 void AddTableReadings(ObjectViews& views, const std::vector<Se2>& poses, FusedCloud* fused) {
     std::vector<Points> table(views.views.size());
-    for (std::size_t k = 0; k < table.size(); ++k) table[k] = std::move(views.views[k].table_points);
+    for (std::size_t k = 0; k < table.size(); ++k)
+        table[k] = std::move(views.views[k].table_points);
     fused->table = FuseTableReadings(table, poses);
     fused->table_known = true;
 }
@@ -130,9 +131,9 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
     // 7. The smallest enclosing cuboid of the outermost surface, and the shape.
     EnvelopeConfig envelope = config.envelope;
     envelope.narrowest_kept_m = config.fusion.support_voxel_m;
-    const auto cuboid = FitEnclosingCuboid(fit.fused, fit.box, n, registered->edges.mean_rmse_m,
-                                           table.residual_sigma_m,
-                                           table.camera_to_table.translation(), envelope);
+    const auto cuboid =
+        FitEnclosingCuboid(fit.fused, fit.box, n, registered->edges.mean_rmse_m,
+                           table.residual_sigma_m, table.camera_to_table.translation(), envelope);
     m.laps.Lap("fit");
     std::array<double, 3> uncertainty{};
     if (cuboid) {

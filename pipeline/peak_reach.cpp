@@ -1,5 +1,7 @@
 #include "pipeline/peak_reach.h"
 
+#include <spdlog/spdlog.h>
+
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <map>
@@ -32,7 +34,8 @@ constexpr double kMaxSlope = 10.0;
 // reading of the same view (all readings as one view where `view` is empty): how finely a view
 // samples the surface across its rays there (on a steep flank the readings stack nearly
 // straight up, their horizontal spacing a fraction of it).
-double ViewSpacing(const std::vector<Eigen::Vector3f>& top, const std::vector<std::uint16_t>& view) {
+double ViewSpacing(const std::vector<Eigen::Vector3f>& top,
+                   const std::vector<std::uint16_t>& view) {
     std::map<int, std::vector<Eigen::Vector3f>> by_view;
     for (std::size_t i = 0; i < top.size(); ++i) {
         by_view[view.empty() ? 0 : view[i]].push_back(top[i]);
@@ -61,9 +64,9 @@ double ViewSpacing(const std::vector<Eigen::Vector3f>& top, const std::vector<st
 // metre runs 1/s metre out per metre down. A top already `narrow_m` wide where it is highest
 // (a face), one that does not widen (a panel's edge, its width its thickness), or widens as a
 // smooth crown does, has none.
-std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top, const Eigen::Vector2d& apex,
-                                 const Eigen::Vector2d* across, double highest, double band_m,
-                                 double narrow_m) {
+std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top,
+                                 const Eigen::Vector2d& apex, const Eigen::Vector2d* across,
+                                 double highest, double band_m, double narrow_m) {
     std::vector<std::vector<double>> bins(kDropBins);
     for (const Eigen::Vector3f& p : top) {
         const Eigen::Vector2d q = p.head<2>().cast<double>() - apex;
@@ -80,7 +83,10 @@ std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top, const 
     const double n = static_cast<double>(x.size());
     double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, sqx = 0.0, sqy = 0.0;
     for (std::size_t i = 0; i < x.size(); ++i) {
-        sx += x[i]; sy += y[i]; sxx += x[i] * x[i]; sxy += x[i] * y[i];
+        sx += x[i];
+        sy += y[i];
+        sxx += x[i] * x[i];
+        sxy += x[i] * y[i];
         sqx += x[i];  // sqrt(x)^2
         sqy += std::sqrt(x[i]) * y[i];
     }
@@ -106,8 +112,8 @@ std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top, const 
 }  // namespace
 
 PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
-                          const std::vector<std::uint16_t>& view, double noise_sigma,
-                          double band_m, double narrow_m, double narrowest_m) {
+                          const std::vector<std::uint16_t>& view, double noise_sigma, double band_m,
+                          double narrow_m, double narrowest_m) {
     PeakReach out;
     if (pts.size() < 20) return out;
     std::vector<std::size_t> order(pts.size());
@@ -150,6 +156,24 @@ PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
     out.above = out.slope * std::max(out.spacing, narrowest_m) / 2.0;
     out.sharp = true;
     return out;
+}
+
+void ReadSharpTop(const Surface& surface, double height_sigma, const EnvelopeConfig& config,
+                  double* height, double* se) {
+    const PeakReach peak =
+        ExtrapolatePeak(surface.points, surface.view, height_sigma, 2.0 * config.cell_height_m,
+                        config.cell_along_m, config.narrowest_kept_m);
+    if (!peak.sharp) return;
+    spdlog::debug(
+        "envelope: a sharp top, its highest readings {:.2f} mm above the cells', slope "
+        "{:.2f}, spacing {:.2f} mm",
+        (peak.highest - *height) * 1e3, peak.slope, peak.spacing * 1e3);
+    if (peak.highest > *height) {
+        *height = peak.highest;
+        *se = height_sigma;
+    }
+    *height += peak.above / 2.0;
+    *se = std::hypot(*se, peak.above / 2.0 / kNormal95);
 }
 
 }  // namespace boxd::envelope

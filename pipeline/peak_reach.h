@@ -11,14 +11,17 @@
 //
 // The principle (enclosing_cuboid.h): what no reading supports goes into the bound. Here the
 // highest readings (the third highest, less what the noise adds to the largest of the readings
-// competing for it) hold the height from below; above them the apex may stand by up to the steeper flanks' slope
-// times half the views' spacing of readings at the top. The height is read halfway, the 95%
-// bound reaching both ends.
+// competing for it) hold the height from below; above them the apex may stand by up to the steeper
+// flanks' slope times half the views' spacing of readings at the top. The height is read halfway,
+// the 95% bound reaching both ends.
 
 #include <Eigen/Core>
 #include <cmath>
 #include <cstdint>
 #include <vector>
+
+#include "pipeline/enclosing_cuboid.h"
+#include "pipeline/surface_cells.h"
 
 namespace boxd::envelope {
 
@@ -38,7 +41,14 @@ struct PeakReach {
 // metre per metre (FlankSlope). `narrowest_m`: the
 // narrowest part the readings keep (EnvelopeConfig::narrowest_kept_m).
 PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
-                          const std::vector<std::uint16_t>& view, double noise_sigma,
-                          double band_m, double narrow_m, double narrowest_m);
+                          const std::vector<std::uint16_t>& view, double noise_sigma, double band_m,
+                          double narrow_m, double narrowest_m);
+
+// A sharp peak or ridge thins the top's cells out below it (peak_reach.h): its highest
+// readings hold the height where they stand above the cells' `height`, and the apex may stand
+// above them by the flanks' slope times the readings' spacing; read halfway, the bound `se`
+// reaching both ends. `height_sigma`: a reading's noise in its height.
+void ReadSharpTop(const Surface& surface, double height_sigma, const EnvelopeConfig& config,
+                  double* height, double* se);
 
 }  // namespace boxd::envelope

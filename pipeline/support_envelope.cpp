@@ -1,11 +1,11 @@
 #include "pipeline/support_envelope.h"
 
 #include <spdlog/fmt/fmt.h>
-#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <utility>
 
 #include "pipeline/foot_band.h"
@@ -13,7 +13,6 @@
 #include "pipeline/layer_marks.h"
 #include "pipeline/parallel_for.h"
 #include "pipeline/peak_reach.h"
-#include "pipeline/student_t.h"
 #include "pipeline/surface_cells.h"
 
 namespace boxd::envelope {
@@ -29,10 +28,9 @@ namespace {
 constexpr double kUnseenShare = 0.1;
 
 // A table reading may land this many of its spreads inside the table's true edge by its noise
-// (TableReadingSpread): the free space beside a foot is taken to begin that much farther out.
-// FreeReach reads a strip's third nearest reading: three of the few readings at the edge all
-// landing 1.5 spreads inside it is a chance of a few in a thousand, and the widest of the
-// wall's strips counts.
+// (TableReadingSpread), so the free space beside a foot begins that much farther out: three of
+// the few readings at the edge (FreeReach reads a strip's third nearest) all landing 1.5
+// spreads inside it is a chance of a few in a thousand.
 constexpr double kTableSpreadSigmas = 1.5;
 
 // The outer layer's largest bound in direction (cos φ, sin φ) and in the opposite one, over
@@ -95,39 +93,6 @@ std::vector<Layers> BuildLayers(const std::vector<Eigen::Vector3f>& pts, const E
         }
     }
     return out;
-}
-
-// Below the lowest row (`foot`, along `u`): a wall sloping outward goes on to the table
-// (foot_band.h). Where nothing read the foot (its lowest readings stand above the band), the
-// table's readings beside the object bound how far it may go (foot_free_space.h): the
-// extrapolation is held within that, and the 95% bound reaches that limit (the object may
-// continue into what nothing read, up to where the table was seen) as well as covering the
-// extrapolation's own error; with no table readings beyond, the foot is open. Without the
-// table's readings (`table` null) a raised foot stays where its readings are.
-void ReachBelow(const FootReach& foot, const std::vector<Eigen::Vector3f>& pts,
-                const Eigen::Vector2d& u, const TableBeside* table, double& reach, double& se,
-                bool& open) {
-    if (!foot.raised) {
-        if (foot.reach > reach) {
-            reach = foot.reach;
-            se = foot.se;
-        }
-        return;
-    }
-    if (table == nullptr) return;
-    const double free = FreeReach(*table, pts, u);
-    if (!std::isfinite(free)) {
-        open = true;
-        return;
-    }
-    // The readings hold the reach from below and the table from above; within that, a wall
-    // sloping outward goes on sloping. The bound reaches the table's limit, and below as far as
-    // the extrapolation's own error or the readings, whichever is nearer.
-    const double read = reach;
-    if (free <= read) return;
-    reach = std::clamp(foot.reach, read, free);
-    const double below = std::min(reach - read, kNormal95 * foot.se);
-    se = std::max(se, std::max(free - reach, below) / kNormal95);
 }
 
 // Leaves out of `coarse` (cells twice the size each way, on the same origin) every cell that
@@ -269,25 +234,63 @@ Alike AlikeRectangles(const std::vector<Support>& supports, int best) {
     return {count, sum_u / count, sum_v / count};
 }
 
-// A sharp peak or ridge thins the top's cells out below it (peak_reach.h): its highest
-// readings hold the height where they stand above the cells' `height`, and the apex may stand
-// above them by the flanks' slope times the readings' spacing; read halfway, the bound `se`
-// reaching both ends. `height_sigma`: a reading's noise in its height.
-void ReadSharpTop(const Surface& surface, double height_sigma, const EnvelopeConfig& config,
-                  double* height, double* se) {
-    const PeakReach peak = ExtrapolatePeak(surface.points, surface.view, height_sigma,
-                                           2.0 * config.cell_height_m, config.cell_along_m,
-                                           config.narrowest_kept_m);
-    if (!peak.sharp) return;
-    spdlog::debug("envelope: a sharp top, its highest readings {:.2f} mm above the cells', slope "
-                  "{:.2f}, spacing {:.2f} mm",
-                  (peak.highest - *height) * 1e3, peak.slope, peak.spacing * 1e3);
-    if (peak.highest > *height) {
-        *height = peak.highest;
-        *se = height_sigma;
+// An unseen side leaves the object unbounded there: a bulge or a flap could stand out
+// anywhere on it, and every rectangle would be a guess. Returns the refusal where a direction's
+// width `w` is unbounded, saying whether no view faced it (`unfaced`; or no camera is known).
+std::optional<Error> UnboundedRefusal(const std::vector<double>& w,
+                                      const std::vector<char>& unfaced, bool no_cameras) {
+    const auto unbounded =
+        std::count_if(w.begin(), w.end(), [](double x) { return !std::isfinite(x); });
+    if (unbounded == 0) return std::nullopt;
+    if (no_cameras || std::count(unfaced.begin(), unfaced.end(), 1) > 0) {
+        return Error{ErrorCode::kInsufficientData,
+                     "a side of the object was never seen: too few views around it to bound it"};
     }
-    *height += peak.above / 2.0;
-    *se = std::hypot(*se, peak.above / 2.0 / kNormal95);
+    return Error{ErrorCode::kInsufficientData,
+                 fmt::format("the object's outline cannot be bounded: in {} of {} directions, each "
+                             "faced by a view, its surface stops well short of its own "
+                             "readings (a part too thin or too sparse to read)",
+                             unbounded, w.size())};
+}
+
+// The least-area rectangle: its two directions' supports, its direction and area.
+struct LeastRectangle {
+    Support su, sv;
+    double phi = 0.0, area = INFINITY;
+};
+
+// The enclosing cuboid of the least rectangle `r` (the `alike` rectangles' mean sides where
+// several are alike) and the top's height; refused where a side was never seen or its foot is
+// open (foot_free_space.h).
+Result<EnclosingCuboid> CuboidOf(const Surface& surface, const LeastRectangle& r,
+                                 const Alike& alike, double sigma, double height_sigma,
+                                 const EnvelopeConfig& config) {
+    const Support &su = r.su, &sv = r.sv;
+    if (!std::isfinite(r.area)) {
+        return Error{ErrorCode::kInsufficientData,
+                     "a side of the object was never seen: too few views around it to bound it"};
+    }
+    if (su.open_forward || su.open_backward || sv.open_forward || sv.open_backward) {
+        return Error{ErrorCode::kInsufficientData,
+                     "nothing was read at the foot of a side of the object, nor on the table "
+                     "beside it: how far it reaches there is unknown (a dark or glossy base, or "
+                     "a shadow; a matte label round the base, a lighter table top or a second "
+                     "camera angle helps)"};
+    }
+    EnclosingCuboid c;
+    const Eigen::Vector2d u(std::cos(r.phi), std::sin(r.phi)), v(-u.y(), u.x());
+    const double lu = alike.orientations > 1 ? alike.along_u : su.Width();
+    const double lv = alike.orientations > 1 ? alike.along_v : sv.Width();
+    c.center_m = 0.5 * (su.forward - su.backward) * u + 0.5 * (sv.forward - sv.backward) * v;
+    c.length_m = std::max(lu, lv);
+    c.width_m = std::min(lu, lv);
+    c.length_axis = lu >= lv ? u : v;
+    double se_top = 0.0;
+    c.height_m = TopBound(surface.points, sigma, height_sigma, surface.radius, config, &se_top);
+    ReadSharpTop(surface, height_sigma, config, &c.height_m, &se_top);
+    const double s_u = su.WidthSe(), s_v = sv.WidthSe();
+    c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u, se_top};
+    return c;
 }
 
 }  // namespace
@@ -321,7 +324,8 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
     const std::vector<Eigen::Vector3f>& pts = surface.points;
     if (pts.empty()) return Error{ErrorCode::kInsufficientData, "no surface above the table"};
     const double radius = surface.radius, top = surface.top;
-    TableBeside table{&surface.table, kTableSpreadSigmas * TableReadingSpread(sigma, surface.cameras),
+    TableBeside table{&surface.table,
+                      kTableSpreadSigmas * TableReadingSpread(sigma, surface.cameras),
                       config.cell_along_m / 4.0, radius};
     const TableBeside* beside = surface.table_known ? &table : nullptr;
     // A side no view faced has no facing surface: its "support" would be whatever faces that
@@ -367,29 +371,13 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
     ParallelFor(n, config.threads, [&](int i) {
         w[i] = width(M_PI * i / n, &coarse[i], &unfaced[static_cast<std::size_t>(i)]);
     });
-    // An unseen side leaves the object unbounded there: a bulge or a flap could stand out
-    // anywhere on it, and every rectangle would be a guess.
-    const auto unbounded =
-        std::count_if(w.begin(), w.end(), [](double x) { return !std::isfinite(x); });
-    if (unbounded > 0) {
-        if (surface.cameras.empty() || std::count(unfaced.begin(), unfaced.end(), 1) > 0) {
-            return Error{
-                ErrorCode::kInsufficientData,
-                "a side of the object was never seen: too few views around it to bound it"};
-        }
-        return Error{
-            ErrorCode::kInsufficientData,
-            fmt::format("the object's outline cannot be bounded: in {} of {} directions, each "
-                        "faced by a view, its surface stops well short of its own "
-                        "readings (a part too thin or too sparse to read)",
-                        unbounded, n)};
-    }
+    if (auto why = UnboundedRefusal(w, unfaced, surface.cameras.empty())) return *why;
     int best = 0;
     for (int i = 1; i < n; ++i) {
         if (w[i] * w[(i + n / 2) % n] < w[best] * w[(best + n / 2) % n]) best = i;
     }
-    double best_phi = M_PI * best / n, best_area = w[best] * w[(best + n / 2) % n];
-    Support su = coarse[best], sv = coarse[(best + n / 2) % n];
+    LeastRectangle r{coarse[best], coarse[(best + n / 2) % n], M_PI * best / n,
+                     w[best] * w[(best + n / 2) % n]};
     const auto alike = AlikeRectangles(coarse, best);
     if (alike.orientations == 1) {
         // Tenths of a step either way, each direction and the one square to it.
@@ -403,40 +391,10 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
                     [&](int k) { fine_w[k] = width(phi_of(k), &fine[k], nullptr); });
         for (std::size_t k = 0; k < fine.size(); k += 2) {
             const double area = fine_w[k] * fine_w[k + 1];
-            if (area < best_area) {
-                best_area = area;
-                best_phi = phi_of(static_cast<int>(k));
-                su = fine[k];
-                sv = fine[k + 1];
-            }
+            if (area < r.area) r = {fine[k], fine[k + 1], phi_of(static_cast<int>(k)), area};
         }
     }
-    if (!std::isfinite(best_area)) {
-        return Error{ErrorCode::kInsufficientData,
-                     "a side of the object was never seen: too few views around it to bound it"};
-    }
-    if (su.open_forward || su.open_backward || sv.open_forward || sv.open_backward) {
-        return Error{ErrorCode::kInsufficientData,
-                     "nothing was read at the foot of a side of the object, nor on the table "
-                     "beside it: how far it reaches there is unknown (a dark or glossy base, or "
-                     "a shadow; a matte label round the base, a lighter table top or a second "
-                     "camera angle helps)"};
-    }
-    EnclosingCuboid c;
-    const Eigen::Vector2d u(std::cos(best_phi), std::sin(best_phi)), v(-u.y(), u.x());
-    const double lu = alike.orientations > 1 ? alike.along_u : su.Width();
-    const double lv = alike.orientations > 1 ? alike.along_v : sv.Width();
-    c.center_m = 0.5 * (su.forward - su.backward) * u + 0.5 * (sv.forward - sv.backward) * v;
-    c.length_m = std::max(lu, lv);
-    c.width_m = std::min(lu, lv);
-    c.length_axis = lu >= lv ? u : v;
-    double se_top = 0.0;
-    c.height_m = TopBound(pts, sigma, height_sigma, radius, config, &se_top);
-    ReadSharpTop(surface, height_sigma, config, &c.height_m, &se_top);
-    const double s_u = su.WidthSe();
-    const double s_v = sv.WidthSe();
-    c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u, se_top};
-    return c;
+    return CuboidOf(surface, r, alike, sigma, height_sigma, config);
 }
 
 }  // namespace boxd::envelope

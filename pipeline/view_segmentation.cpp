@@ -146,8 +146,8 @@ SegmentedView SegmentView(const DepthMap& depth, const CameraIntrinsics& camera,
             }
         }
     }
-    view.table_points = TableBesideObject(table, view.points, config.table_margin_m,
-                                          config.cylinder_radius_m);
+    view.table_points =
+        TableBesideObject(table, view.points, config.table_margin_m, config.cylinder_radius_m);
     return view;
 }
 

@@ -121,6 +121,12 @@ void RemoveStaleFrames(const fs::path& dir, const std::vector<fs::path>& previou
     }
 }
 
+// Sets `to` from `from` where an option was given.
+template <typename T>
+void SetIfGiven(T& to, const std::optional<T>& from) {
+    if (from) to = *from;
+}
+
 // Returns the noise model's parameters with the effects asked for, or none when none is.
 std::optional<SensorNoiseParams> SensorEffects(const SynthOptions& o, NoiseModel model) {
     if (!o.shadow_baseline_m && !o.edge_fattening_px && !o.correlated_noise_m &&
@@ -128,12 +134,12 @@ std::optional<SensorNoiseParams> SensorEffects(const SynthOptions& o, NoiseModel
         return std::nullopt;
     }
     SensorNoiseParams p = DefaultSensorNoise(model);
-    if (o.shadow_baseline_m) p.shadow_baseline_m = *o.shadow_baseline_m;
-    if (o.edge_fattening_px) p.edge_fattening_px = *o.edge_fattening_px;
-    if (o.correlated_noise_m) p.correlated_sigma_m = *o.correlated_noise_m;
-    if (o.correlation_px) p.correlation_px = *o.correlation_px;
-    if (o.fixed_pattern_m) p.fixed_pattern_m = *o.fixed_pattern_m;
-    if (o.fixed_pattern_px) p.fixed_pattern_px = *o.fixed_pattern_px;
+    SetIfGiven(p.shadow_baseline_m, o.shadow_baseline_m);
+    SetIfGiven(p.edge_fattening_px, o.edge_fattening_px);
+    SetIfGiven(p.correlated_sigma_m, o.correlated_noise_m);
+    SetIfGiven(p.correlation_px, o.correlation_px);
+    SetIfGiven(p.fixed_pattern_m, o.fixed_pattern_m);
+    SetIfGiven(p.fixed_pattern_px, o.fixed_pattern_px);
     return p;
 }
 
@@ -175,20 +181,20 @@ Result<SyntheticStationConfig> MakeConfig(const SynthOptions& o) {
         c.dark_from_m = o.dark_band.at(0);
         c.dark_to_m = o.dark_band.at(1);
     }
-    if (o.distance_m) c.camera_pose.distance_m = *o.distance_m;
-    if (o.elevation_deg) c.camera_pose.elevation_deg = *o.elevation_deg;
-    if (o.aim_height_m) c.camera_pose.aim_height_m = *o.aim_height_m;
+    SetIfGiven(c.camera_pose.distance_m, o.distance_m);
+    SetIfGiven(c.camera_pose.elevation_deg, o.elevation_deg);
+    SetIfGiven(c.camera_pose.aim_height_m, o.aim_height_m);
     auto noise = ParseNoiseModel(o.noise);
     if (!noise) return noise.error();
     c.noise = *noise;
     c.sensor_noise = SensorEffects(o, *noise);
     c.seed = o.seed;
-    if (o.angle_error_deg) c.angle_error_deg = *o.angle_error_deg;
-    if (o.calib_center_error_m) c.calib_center_error_m = *o.calib_center_error_m;
-    if (o.calib_axis_error_deg) c.calib_axis_error_deg = *o.calib_axis_error_deg;
-    if (o.depth_offset_m) c.true_depth_offset_m = *o.depth_offset_m;
-    if (o.calib_depth_offset_error_m) c.calib_depth_offset_error_m = *o.calib_depth_offset_error_m;
-    if (o.focal_error_pct) c.focal_error_pct = *o.focal_error_pct;
+    SetIfGiven(c.angle_error_deg, o.angle_error_deg);
+    SetIfGiven(c.calib_center_error_m, o.calib_center_error_m);
+    SetIfGiven(c.calib_axis_error_deg, o.calib_axis_error_deg);
+    SetIfGiven(c.true_depth_offset_m, o.depth_offset_m);
+    SetIfGiven(c.calib_depth_offset_error_m, o.calib_depth_offset_error_m);
+    SetIfGiven(c.focal_error_pct, o.focal_error_pct);
     if (o.depth_unit_m) {
         if (!(*o.depth_unit_m >= kMinDepthUnitM && *o.depth_unit_m <= kMaxDepthUnitM)) {
             return Error{ErrorCode::kInvalidInput,

@@ -87,8 +87,8 @@ Traced TraceRays(const SyntheticScene& scene, const SyntheticRayCaster& caster,
             }
             const SyntheticRayHit hit = caster.Cast(u, v);
             // A dark material returns no depth: the pixel reads nothing (not what lies behind).
-            const bool dark = hit.object && hit.height_m >= cfg.dark_from_m &&
-                              hit.height_m < cfg.dark_to_m;
+            const bool dark =
+                hit.object && hit.height_m >= cfg.dark_from_m && hit.height_m < cfg.dark_to_m;
             // The projector does not light it, or the second imager does not see it.
             const bool shadow = baseline != 0.0 && hit.z_m > 0.0 &&
                                 caster.Blocked(second, hit.point, kShadowMargin);

@@ -194,8 +194,7 @@ bool SyntheticRayCaster::Blocked(const Eigen::Vector3d& from, const Eigen::Vecto
     if (!(length > margin_m)) return false;
     const double t_max = 1.0 - margin_m / length;  // the segment runs over t in (0, 1)
     if (ideal_box_) {
-        const Eigen::Vector3d rel(from.x() - box_center_.x(), from.y() - box_center_.y(),
-                                  from.z());
+        const Eigen::Vector3d rel(from.x() - box_center_.x(), from.y() - box_center_.y(), from.z());
         const double ob[3] = {box_cos_ * rel.x() + box_sin_ * rel.y(),
                               -box_sin_ * rel.x() + box_cos_ * rel.y(), rel.z()};
         const double db[3] = {box_cos_ * d.x() + box_sin_ * d.y(),

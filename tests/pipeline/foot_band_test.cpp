@@ -35,8 +35,8 @@ TEST(FootBand, AFlankSlopingOutwardIsExtendedToTheTable) {
     // A prism's flank: 60 mm out at the table, coming in 0.577 m per metre of height.
     auto prism = [](double z) { return 0.060 - 0.577 * z; };
     for (unsigned seed = 1; seed <= 5; ++seed) {
-        const FootReach foot = ExtrapolateFoot(Layer(prism, config.min_z_m, 0.1, seed, config),
-                                               config);
+        const FootReach foot =
+            ExtrapolateFoot(Layer(prism, config.min_z_m, 0.1, seed, config), config);
         ASSERT_TRUE(std::isfinite(foot.reach)) << "seed " << seed;
         EXPECT_NEAR(foot.slope, 0.577, 0.05) << "seed " << seed;
         // Its readings stop 7 mm short of the foot; the extension lands within its bound.
@@ -111,10 +111,10 @@ TEST(FootBand, ABendingFootWidensTheBound) {
     auto sack = [](double z) { return 0.1 - 0.5 * z + 4.0 * z * z; };
     auto flat = [](double z) { return 0.1 - 0.5 * z; };
     for (unsigned seed = 1; seed <= 5; ++seed) {
-        const FootReach bending = ExtrapolateFoot(Layer(sack, config.min_z_m, 0.05, seed, config),
-                                                  config);
-        const FootReach straight = ExtrapolateFoot(Layer(flat, config.min_z_m, 0.05, seed, config),
-                                                   config);
+        const FootReach bending =
+            ExtrapolateFoot(Layer(sack, config.min_z_m, 0.05, seed, config), config);
+        const FootReach straight =
+            ExtrapolateFoot(Layer(flat, config.min_z_m, 0.05, seed, config), config);
         ASSERT_TRUE(std::isfinite(bending.reach) && std::isfinite(straight.reach));
         EXPECT_GT(bending.se, straight.se) << "seed " << seed;
         EXPECT_LT(std::abs(bending.reach - sack(0.0)), 2.0 * bending.se) << "seed " << seed;

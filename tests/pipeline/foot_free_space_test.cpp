@@ -42,9 +42,7 @@ Scene Wall(double read, double foot, unsigned seed) {
     return s;
 }
 
-TableBeside Beside(const Scene& s) {
-    return TableBeside{&s.table, 1.5 * kSpread, 0.003, 0.3};
-}
+TableBeside Beside(const Scene& s) { return TableBeside{&s.table, 1.5 * kSpread, 0.003, 0.3}; }
 
 TEST(FootFreeSpace, TheTableBesideADarkFootBoundsItFromAbove) {
     const Eigen::Vector2d u(1.0, 0.0);
@@ -53,7 +51,7 @@ TEST(FootFreeSpace, TheTableBesideADarkFootBoundsItFromAbove) {
         const Scene s = Wall(0.186, 0.2, seed);
         const double free = FreeReach(Beside(s), s.object, u);
         ASSERT_TRUE(std::isfinite(free)) << "seed " << seed;
-        EXPECT_GE(free, 0.2) << "seed " << seed;   // never inside the true foot
+        EXPECT_GE(free, 0.2) << "seed " << seed;  // never inside the true foot
         // Beyond it by no more than the third reading's spacing (2 mm apart, a strip's nearest
         // three may lie 4 mm out) and the noise's largest over the wall's strips and tolerance.
         EXPECT_LT(free, 0.2 + 0.004 + 5.0 * kSpread) << "seed " << seed;
@@ -108,7 +106,8 @@ Surface DarkFootedPrism(bool table_read, unsigned seed) {
         const double w = half_width(z);
         for (double x = -kLength / 2; x <= kLength / 2; x += 0.0015) {
             for (double side : {-1.0, 1.0}) {
-                s.points.emplace_back(static_cast<float>(x), static_cast<float>(side * w + noise(rng)),
+                s.points.emplace_back(static_cast<float>(x),
+                                      static_cast<float>(side * w + noise(rng)),
                                       static_cast<float>(z));
             }
         }

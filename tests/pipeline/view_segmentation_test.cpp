@@ -189,7 +189,8 @@ TEST(SegmentView, KeepsTheTableReadingsBesideTheObject) {
     Raise(depth, 28, 36, 20, 28, 0.1);  // a small box: 0.9 m away, 18 mm a pixel at the table
     SegmentationConfig config = SmallVolume();
     config.table_margin_m = 0.05;
-    const SegmentedView view = SegmentView(depth, cam, StationCalibration{}, LookingDown(), config, 0);
+    const SegmentedView view =
+        SegmentView(depth, cam, StationCalibration{}, LookingDown(), config, 0);
     ASSERT_EQ(view.points.size(), 64u);
     ASSERT_FALSE(view.table_points.empty());
     float box_x0 = INFINITY, box_x1 = -INFINITY;
@@ -210,8 +211,8 @@ TEST(SegmentView, KeepsTheTableReadingsBesideTheObject) {
     EXPECT_LT(view.table_points.size(), 64u * 48u / 2u);
     // No margin: none kept.
     config.table_margin_m = 0.0;
-    EXPECT_TRUE(
-        SegmentView(depth, cam, StationCalibration{}, LookingDown(), config, 0).table_points.empty());
+    EXPECT_TRUE(SegmentView(depth, cam, StationCalibration{}, LookingDown(), config, 0)
+                    .table_points.empty());
 }
 
 TEST(SegmentationConfig, ValidateNamesField) {

@@ -145,7 +145,8 @@ TEST(CliSynth, BadArgumentsExitTwoWithOneLine) {
     EXPECT_NE(r.err.find("length"), std::string::npos) << r.err;
     const auto n = RunBoxd(Synth(dir / "s", {"--dims", "0.3", "0.2", "0.2", "--noise", "foo"}));
     EXPECT_NE(n.err.find("foo"), std::string::npos) << n.err;
-    const auto b = RunBoxd(Synth(dir / "s", {"--dims", "0.3", "0.2", "0.2", "--shadow-baseline-m", "2"}));
+    const auto b =
+        RunBoxd(Synth(dir / "s", {"--dims", "0.3", "0.2", "0.2", "--shadow-baseline-m", "2"}));
     EXPECT_NE(b.err.find("shadow_baseline_m"), std::string::npos) << b.err;
 }
 
