@@ -89,6 +89,43 @@ void AddTableReadings(ObjectViews& views, const std::vector<Se2>& poses, FusedCl
     fused->table_known = true;
 }
 
+// The 95% bounds of `cuboid` (SPEC section 5's uncertainty_m): the faces' own scatter, what the
+// registration may still have moved them by, and for the height the table's centre and the
+// depths' rounding.
+std::array<double, 3> Bounds95(const Session& session, const FusedFit& fit,
+                               const EnclosingCuboid& cuboid, const RegisteredViews& registered,
+                               const TablePlaneFit& table, const MeasureConfig& config) {
+    // The faces' own scatter, and what the registration may still have moved them by; the
+    // height is read from the table's plane, which is known as well as its poses agree.
+    const auto moved =
+        RegistrationSigma(fit.fused, cuboid, registered.poses, registered.pose_covariance);
+    spdlog::debug(
+        "uncertainty: faces {:.3f} {:.3f} {:.3f} mm, registration {:.3f} {:.3f} mm, table "
+        "{:.3f} mm",
+        cuboid.sigma_m[0] * 1e3, cuboid.sigma_m[1] * 1e3, cuboid.sigma_m[2] * 1e3, moved[0] * 1e3,
+        moved[1] * 1e3, table.center_se_m * 1e3);
+    // The rounding of the recorded depths, which every view of the top and every pose of
+    // the table meet alike (depth_rounding.h): the two surfaces lie at other depths, so
+    // their roundings are independent.
+    const double unit = session.camera.depth_unit_m;
+    const double rounding = std::hypot(
+        SharedRoundingSigma(TopRounding(fit.fused, registered.poses, cuboid, table.camera_to_table,
+                                        session.calibration, config.box_fit.min_band_m,
+                                        EdgeMargin(config.envelope.edge_margin_m,
+                                                   std::min(cuboid.width_m, cuboid.height_m),
+                                                   fit.box ? fit.box->rounded_margin_m : 0.0)),
+                            unit),
+        SharedRoundingSigma(table.rounding, unit));
+    spdlog::debug("uncertainty: the depths' rounding {:.3f} mm in the height", rounding * 1e3);
+    const double shared[3] = {moved[0], moved[1], std::hypot(table.center_se_m, rounding)};
+    std::array<double, 3> uncertainty{};
+    for (std::size_t i = 0; i < 3; ++i) {
+        // kNormal95 sigmas: the 95% bound of SPEC section 5's uncertainty_m.
+        uncertainty[i] = kNormal95 * std::hypot(cuboid.sigma_m[i], shared[i]);
+    }
+    return uncertainty;
+}
+
 // Stages 4b to 7 on the views and edges of `stream`.
 MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const MeasureConfig& config,
                            BoxMethod method, const MonotonicMs& clock) {
@@ -142,34 +179,7 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
         quality.face_excess_ratio = cuboid->max_relative_excess;
         quality.cuboid_assumed = cuboid->assumed;
         if (std::isfinite(cuboid->flatness)) quality.face_flatness = cuboid->flatness;
-        // The faces' own scatter, and what the registration may still have moved them by; the
-        // height is read from the table's plane, which is known as well as its poses agree.
-        const auto moved =
-            RegistrationSigma(fit.fused, *cuboid, registered->poses, registered->pose_covariance);
-        spdlog::debug(
-            "uncertainty: faces {:.3f} {:.3f} {:.3f} mm, registration {:.3f} {:.3f} mm, table "
-            "{:.3f} mm",
-            cuboid->sigma_m[0] * 1e3, cuboid->sigma_m[1] * 1e3, cuboid->sigma_m[2] * 1e3,
-            moved[0] * 1e3, moved[1] * 1e3, table.center_se_m * 1e3);
-        // The rounding of the recorded depths, which every view of the top and every pose of
-        // the table meet alike (depth_rounding.h): the two surfaces lie at other depths, so
-        // their roundings are independent.
-        const double unit = session.camera.depth_unit_m;
-        const double rounding =
-            std::hypot(SharedRoundingSigma(
-                           TopRounding(fit.fused, registered->poses, *cuboid, table.camera_to_table,
-                                       session.calibration, config.box_fit.min_band_m,
-                                       EdgeMargin(config.envelope.edge_margin_m,
-                                                  std::min(cuboid->width_m, cuboid->height_m),
-                                                  fit.box ? fit.box->rounded_margin_m : 0.0)),
-                           unit),
-                       SharedRoundingSigma(table.rounding, unit));
-        spdlog::debug("uncertainty: the depths' rounding {:.3f} mm in the height", rounding * 1e3);
-        const double shared[3] = {moved[0], moved[1], std::hypot(table.center_se_m, rounding)};
-        for (std::size_t i = 0; i < 3; ++i) {
-            // kNormal95 sigmas: the 95% bound of SPEC section 5's uncertainty_m.
-            uncertainty[i] = kNormal95 * std::hypot(cuboid->sigma_m[i], shared[i]);
-        }
+        uncertainty = Bounds95(session, fit, *cuboid, *registered, table, config);
     }
     const auto why = CheckEnclosingCuboid(fit, cuboid, uncertainty, refuse);
     m.out.cloud = std::move(fit.fused.points);
