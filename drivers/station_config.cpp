@@ -69,7 +69,7 @@ Reader Noise(NoiseModel& target) {
         std::string name;
         if (auto st = Value(name)(node, key); !st) return st;
         auto model = ParseNoiseModel(name);
-        if (!model) return KeyError(key, "must be none, kinect or realsense, got '" + name + "'");
+        if (!model) return KeyError(key, "must be none, kinect, realsense or tof, got '" + name + "'");
         target = *model;
         return OkStatus();
     };

@@ -49,7 +49,7 @@ struct SynthOptions {
     std::vector<double> second_dims, second_offset, dark_band;
     // The effects of real cameras (sensor_effects.h) on top of the noise model.
     std::optional<double> shadow_baseline_m, correlated_noise_m, correlation_px;
-    std::optional<double> fixed_pattern_m, fixed_pattern_px;
+    std::optional<double> fixed_pattern_m, fixed_pattern_px, multipath_albedo;
     std::optional<int> edge_fattening_px;
     std::optional<int> intruder_pose;
     bool force = false;
@@ -130,7 +130,7 @@ void SetIfGiven(T& to, const std::optional<T>& from) {
 // Returns the noise model's parameters with the effects asked for, or none when none is.
 std::optional<SensorNoiseParams> SensorEffects(const SynthOptions& o, NoiseModel model) {
     if (!o.shadow_baseline_m && !o.edge_fattening_px && !o.correlated_noise_m &&
-        !o.fixed_pattern_m) {
+        !o.fixed_pattern_m && !o.multipath_albedo) {
         return std::nullopt;
     }
     SensorNoiseParams p = DefaultSensorNoise(model);
@@ -140,6 +140,7 @@ std::optional<SensorNoiseParams> SensorEffects(const SynthOptions& o, NoiseModel
     SetIfGiven(p.correlation_px, o.correlation_px);
     SetIfGiven(p.fixed_pattern_m, o.fixed_pattern_m);
     SetIfGiven(p.fixed_pattern_px, o.fixed_pattern_px);
+    SetIfGiven(p.multipath_albedo, o.multipath_albedo);
     return p;
 }
 
@@ -269,6 +270,9 @@ void AddSensorEffectOptions(CLI::App* sub, SynthOptions& o) {
                     "A bias pattern the same in every frame: sigma at 1 m (m), growing as depth^2");
     sub->add_option("--fixed-pattern-px", o.fixed_pattern_px,
                     "Spacing of the fixed pattern's knots (pixels, default 64)");
+    sub->add_option("--multipath-albedo", o.multipath_albedo,
+                    "A time-of-flight camera's multipath: the surfaces' diffuse reflectance "
+                    "(0-1; tof: 0.5, 0: none)");
 }
 
 }  // namespace
@@ -282,7 +286,7 @@ void AddSynth(CLI::App& app, Runner& run) {
     sub->add_option("--poses", o->poses, "Turntable poses over 360 degrees")->capture_default_str();
     sub->add_option("--frames", o->frames, "Depth frames per pose")->capture_default_str();
     sub->add_option("--seed", o->seed, "Random seed")->capture_default_str();
-    sub->add_option("--noise", o->noise, "Sensor noise: kinect, realsense or none")
+    sub->add_option("--noise", o->noise, "Sensor noise: kinect, realsense, tof or none")
         ->capture_default_str();
     sub->add_option("--offset", o->offset, "Box centre offset X Y from the axis (m)")->expected(2);
     sub->add_option("--yaw", o->yaw_deg, "Box yaw at pose 0 (deg)");

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "drivers/sim/multipath.h"
 #include "drivers/sim/sensor_effects.h"
 #include "drivers/sim/synthetic_geometry.h"
 #include "drivers/sim/synthetic_random.h"
@@ -132,6 +133,11 @@ DepthImage RenderDepthFrame(const SyntheticScene& scene, double true_angle_rad,
     const std::uint64_t pixel_seed = rnd::Derive(frame_seed, kPixel);
 
     Traced traced = TraceRays(scene, caster, pixel_seed);
+    if (noise.multipath_albedo > 0.0) {
+        const std::vector<float> extra =
+            MultipathDepthError(caster, cam, noise.multipath_albedo, traced.z);
+        for (std::size_t i = 0; i < extra.size(); ++i) traced.z[i] += extra[i];
+    }
     const std::vector<float> z =
         noise.edge_fattening_px > 0
             ? sensor_effects::FattenEdges(traced.z, w, h, noise.edge_fattening_px,
@@ -146,7 +152,8 @@ DepthImage RenderDepthFrame(const SyntheticScene& scene, double true_angle_rad,
     const double cos_dropout_start = std::cos(noise.dropout_start_deg * kDegToRad);
     const double dropout_span = noise.dropout_full_deg - noise.dropout_start_deg;
     const bool noisy_axis = noise.axial != NoiseModel::kNone;
-    const bool needs_angle = noise.axial == NoiseModel::kKinect;  // its sigma depends on incidence
+    // Their sigmas depend on the incidence.
+    const bool needs_angle = noise.axial == NoiseModel::kKinect || noise.axial == NoiseModel::kToF;
     const double focal_px = 0.5 * (cam.fx + cam.fy);
     const double hole_threshold = noise.hole_fraction * 65536.0;
     const double inverse_unit = 1.0 / cam.depth_unit_m;

@@ -1,7 +1,8 @@
 #pragma once
 // Depth-sensor noise models of the synthetic station (SPEC section 7): the axial noise formulas,
 // the Kinect v1 disparity quantisation and the parameters of the other artefacts (lateral
-// jitter, flying pixels, grazing-angle dropouts, random holes, working range).
+// jitter, flying pixels, grazing-angle dropouts, random holes, working range, a time-of-flight
+// camera's multipath).
 
 #include <algorithm>
 #include <array>
@@ -13,9 +14,9 @@
 
 namespace boxd {
 
-enum class NoiseModel { kNone, kKinect, kRealSense };
+enum class NoiseModel { kNone, kKinect, kRealSense, kToF };
 
-// Returns "none" / "kinect" / "realsense".
+// Returns "none" / "kinect" / "realsense" / "tof".
 const char* NoiseModelName(NoiseModel m);
 // Returns the noise model named `name`, or an error naming it.
 Result<NoiseModel> ParseNoiseModel(const std::string& name);
@@ -27,6 +28,7 @@ struct SensorNoiseParams {
     bool disparity_quantisation = false;   // Kinect v1 11-bit disparity steps
     double stereo_baseline_m = 0.05;       // RealSense formula: baseline
     double stereo_subpixel = 0.08;         // RealSense formula: disparity sigma in pixels
+    double tof_sigma_m = 0.0015;           // ToF formula: sigma at 1 m, head-on
     double flying_pixel_probability =
         0.0;  // chance that a pixel at a depth jump gets a mixed depth
     double flying_pixel_min_jump_m = 0.02;  // a neighbour this much nearer/farther is a jump
@@ -49,6 +51,10 @@ struct SensorNoiseParams {
     // 1 m, the same in every frame of a session.
     double fixed_pattern_m = 0.0;
     double fixed_pattern_px = 64.0;
+    // A time-of-flight camera's multipath (multipath.h): the diffuse reflectance of every surface
+    // at the camera's wavelength, which sets how much of its light reaches a point by way of
+    // another (0: none).
+    double multipath_albedo = 0.0;
 
     // Returns an error naming the first invalid field (prefixed with `where`), or Ok.
     Status Validate(const std::string& where = "sensor_noise") const;
@@ -83,6 +89,14 @@ inline double StereoAxialSigma(double z_m, double focal_px, double baseline_m, d
     return z_m * z_m * subpixel / (focal_px * baseline_m);
 }
 
+// Returns the axial sigma (m) of a continuous-wave time-of-flight camera: shot-noise limited, it
+// falls as one over the square root of the returned amplitude, which falls as cos(incidence) /
+// z^2: sigma_1m * z / sqrt(cos theta) (Lange and Seitz, "Solid-state time-of-flight range
+// camera", IEEE J. Quantum Electronics 37(3), 2001). cos theta is taken no lower than 0.1.
+inline double ToFAxialSigma(double z_m, double incidence_rad, double sigma_1m) {
+    return sigma_1m * z_m / std::sqrt(std::max(0.1, std::cos(incidence_rad)));
+}
+
 // Returns the axial sigma (m) of `params` at `z_m` and `incidence_rad` (0 for kNone).
 inline double AxialSigma(const SensorNoiseParams& params, double z_m, double incidence_rad,
                          double focal_px) {
@@ -94,6 +108,8 @@ inline double AxialSigma(const SensorNoiseParams& params, double z_m, double inc
         case NoiseModel::kRealSense:
             return StereoAxialSigma(z_m, focal_px, params.stereo_baseline_m,
                                     params.stereo_subpixel);
+        case NoiseModel::kToF:
+            return ToFAxialSigma(z_m, incidence_rad, params.tof_sigma_m);
     }
     return 0.0;
 }

@@ -578,6 +578,22 @@ TEST(SyntheticStation, ValidateNamesTheBadField) {
     EXPECT_FALSE(ParseNoiseModel("foo").ok());
     EXPECT_EQ(*ParseNoiseModel("realsense"), NoiseModel::kRealSense);
     EXPECT_STREQ(NoiseModelName(NoiseModel::kKinect), "kinect");
+    EXPECT_EQ(*ParseNoiseModel("tof"), NoiseModel::kToF);
+    EXPECT_STREQ(NoiseModelName(NoiseModel::kToF), "tof");
+}
+
+TEST(SensorNoise, ATimeOfFlightSigmaGrowsWithDepthAndIncidence) {
+    // One over the square root of the amplitude, which falls as cos(incidence) / z^2.
+    EXPECT_NEAR(ToFAxialSigma(1.0, 0.0, 0.0015), 0.0015, 1e-12);
+    EXPECT_NEAR(ToFAxialSigma(2.0, 0.0, 0.0015), 0.003, 1e-12);
+    EXPECT_NEAR(ToFAxialSigma(1.0, M_PI / 3.0, 0.0015), 0.0015 * std::sqrt(2.0), 1e-12);
+    EXPECT_NEAR(ToFAxialSigma(1.0, M_PI / 2.0, 0.0015), 0.0015 / std::sqrt(0.1), 1e-12);
+    SensorNoiseParams tof = DefaultSensorNoise(NoiseModel::kToF);
+    EXPECT_TRUE(tof.Validate().ok());
+    EXPECT_GT(tof.multipath_albedo, 0.0);
+    EXPECT_FALSE(tof.disparity_quantisation);
+    tof.multipath_albedo = 1.5;
+    EXPECT_NE(tof.Validate().error().message.find("multipath_albedo"), std::string::npos);
 }
 
 }  // namespace
