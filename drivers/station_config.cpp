@@ -226,6 +226,7 @@ Result<StationCalibration> ParseCalibration(const YAML::Node& node) {
                               {"depth_offset_m", Value(c.depth_offset_m)},
                               {"depth_scale", Value(c.depth_scale)},
                               {"focal_scale", Value(c.focal_scale)},
+                              {"multipath_albedo", Value(c.multipath_albedo)},
                           });
         !st) {
         return st.error();

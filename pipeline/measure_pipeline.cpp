@@ -94,7 +94,8 @@ void AddTableReadings(ObjectViews& views, const std::vector<Se2>& poses, FusedCl
 // depths' rounding.
 std::array<double, 3> Bounds95(const Session& session, const FusedFit& fit,
                                const EnclosingCuboid& cuboid, const RegisteredViews& registered,
-                               const TablePlaneFit& table, const MeasureConfig& config) {
+                               const TablePlaneFit& table, double multipath_m,
+                               const MeasureConfig& config) {
     // The faces' own scatter, and what the registration may still have moved them by; the
     // height is read from the table's plane, which is known as well as its poses agree.
     const auto moved =
@@ -118,10 +119,14 @@ std::array<double, 3> Bounds95(const Session& session, const FusedFit& fit,
         SharedRoundingSigma(table.rounding, unit));
     spdlog::debug("uncertainty: the depths' rounding {:.3f} mm in the height", rounding * 1e3);
     const double shared[3] = {moved[0], moved[1], std::hypot(table.center_se_m, rounding)};
+    // A time-of-flight camera's multipath correction, trusted to within its own size
+    // (multipath_correction.h): a 95% bound of that size on every dimension.
+    const double multipath = multipath_m / kNormal95;
+    spdlog::debug("uncertainty: multipath corrections of {:.3f} mm", multipath_m * 1e3);
     std::array<double, 3> uncertainty{};
     for (std::size_t i = 0; i < 3; ++i) {
         // kNormal95 sigmas: the 95% bound of SPEC section 5's uncertainty_m.
-        uncertainty[i] = kNormal95 * std::hypot(cuboid.sigma_m[i], shared[i]);
+        uncertainty[i] = kNormal95 * std::hypot(cuboid.sigma_m[i], shared[i], multipath);
     }
     return uncertainty;
 }
@@ -179,11 +184,15 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
         quality.face_excess_ratio = cuboid->max_relative_excess;
         quality.cuboid_assumed = cuboid->assumed;
         if (std::isfinite(cuboid->flatness)) quality.face_flatness = cuboid->flatness;
-        uncertainty = Bounds95(session, fit, *cuboid, *registered, table, config);
+        uncertainty =
+            Bounds95(session, fit, *cuboid, *registered, table, stream.multipath_m(), config);
     }
-    const auto why = CheckEnclosingCuboid(fit, cuboid, uncertainty, refuse);
+    auto why = CheckEnclosingCuboid(fit, cuboid, uncertainty, refuse);
     m.out.cloud = std::move(fit.fused.points);
-    if (why) return m.Refused(*why);
+    if (why) {
+        ExplainMultipath(*why, stream.multipath_m());
+        return m.Refused(*why);
+    }
 
     quality.confidence = Confidence(*registered, n, fit.box ? fit.box->face_sigma_m : 0.0,
                                     quality.points, config.confidence);

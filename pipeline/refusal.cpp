@@ -241,4 +241,12 @@ std::optional<MeasurementReason> CheckEnclosingCuboid(const FusedFit& fit,
     return std::nullopt;
 }
 
+void ExplainMultipath(MeasurementReason& why, double multipath_m) {
+    if (why.code != ErrorCode::kUncertain || !(multipath_m > 0.0)) return;
+    why.message += fmt::format(
+        "; the time-of-flight camera's multipath correction alone is {:.1f} mm (its light "
+        "reaching the parcel by way of the table: a matte dark table top lowers it)",
+        multipath_m * 1000.0);
+}
+
 }  // namespace boxd

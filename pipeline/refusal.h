@@ -75,4 +75,8 @@ std::optional<MeasurementReason> CheckEnclosingCuboid(const FusedFit& fit,
                                                       const std::array<double, 3>& uncertainty_m,
                                                       const RefusalConfig& refuse);
 
+// Adds to an UNCERTAIN refusal the share of a time-of-flight camera's multipath correction
+// (`multipath_m`, the bound's own term; multipath_correction.h) and what lowers it.
+void ExplainMultipath(MeasurementReason& why, double multipath_m);
+
 }  // namespace boxd

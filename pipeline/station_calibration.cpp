@@ -25,6 +25,9 @@ Status StationCalibration::Validate(const std::string& where) const {
     if (!std::isfinite(focal_scale) || focal_scale < 0.8 || focal_scale > 1.25) {
         return bad("focal_scale", "must be a finite number in 0.8..1.25");
     }
+    if (!std::isfinite(multipath_albedo) || multipath_albedo < 0.0 || multipath_albedo > 1.0) {
+        return bad("multipath_albedo", "must be a finite number in 0..1");
+    }
     return OkStatus();
 }
 

@@ -18,6 +18,10 @@ struct StationCalibration {
     // The lens: the focal lengths used are the camera's recorded fx, fy times this (factory
     // intrinsics are often a per cent off, which stretches every lateral size by as much).
     double focal_scale = 1.0;
+    // A time-of-flight camera's multipath (multipath_correction.h): the diffuse reflectance of
+    // the station's table and parcels in the camera's light, which sets how much light reaches a
+    // point by way of another surface. 0: a camera without multipath (structured light, stereo).
+    double multipath_albedo = 0.0;
 
     // Returns an error naming the first invalid field (prefixed with `where`), or Ok.
     Status Validate(const std::string& where = "calibration") const;

@@ -46,11 +46,13 @@ json Vec3(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()});
 }  // namespace
 
 json ToJson(const StationCalibration& c) {
-    return {{"table_center_m", Vec3(c.table_center_m)},
-            {"table_axis", Vec3(c.table_axis)},
-            {"depth_offset_m", c.depth_offset_m},
-            {"depth_scale", c.depth_scale},
-            {"focal_scale", c.focal_scale}};
+    json j = {{"table_center_m", Vec3(c.table_center_m)},
+              {"table_axis", Vec3(c.table_axis)},
+              {"depth_offset_m", c.depth_offset_m},
+              {"depth_scale", c.depth_scale},
+              {"focal_scale", c.focal_scale}};
+    if (c.multipath_albedo > 0.0) j["multipath_albedo"] = c.multipath_albedo;
+    return j;
 }
 
 Result<StationCalibration> StationCalibrationFromJson(const json& j, const std::string& where) {
@@ -66,7 +68,9 @@ Result<StationCalibration> StationCalibrationFromJson(const json& j, const std::
     }
     for (const auto& [key, dst, required] : {std::tuple{"depth_offset_m", &c.depth_offset_m, true},
                                              std::tuple{"depth_scale", &c.depth_scale, false},
-                                             std::tuple{"focal_scale", &c.focal_scale, false}}) {
+                                             std::tuple{"focal_scale", &c.focal_scale, false},
+                                             std::tuple{"multipath_albedo", &c.multipath_albedo,
+                                                        false}}) {
         auto m = Member(j, where, key, required);
         if (!m) return m.error();
         if (*m == nullptr) continue;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <memory>
 
+#include "pipeline/multipath_correction.h"
 #include "pipeline/parallel_for.h"
 
 namespace boxd {
@@ -105,6 +106,10 @@ ViewStream::Inspected ViewStream::Inspect(std::size_t k, PreparedPose pose) cons
     Inspected out;
     out.depth = UsableDepth(std::move(pose), k, config_.refusal);
     if (!out.depth) return out;
+    MultipathCorrection corrected =
+        CorrectMultipath(std::move(*out.depth), header_.camera, header_.calibration);
+    out.depth = std::move(corrected.depth);
+    out.multipath_m = corrected.object_m;
     const std::size_t share = std::max<std::size_t>(
         100, std::min(kCandidatesPerPose,
                       kCandidatesInAll / std::max<std::size_t>(1, plan_deg_.size())));
@@ -120,6 +125,7 @@ bool ViewStream::Accept(std::size_t k, Inspected pose) {
         return false;
     }
     candidates_[k] = std::move(pose.candidates);
+    multipath_m_ = std::max(multipath_m_, pose.multipath_m);
     pending_.push_back(std::move(*pose.depth));
     return true;
 }
@@ -227,9 +233,10 @@ std::optional<MeasurementReason> ViewStream::Complete() {
             table_ = *all;
             move_ = table_.camera_to_table * provisional_->camera_to_table.inverse();
             const Eigen::Isometry3f move = move_.cast<float>();
-            spdlog::debug("table: refitted to every pose, the views move by {:.3f} mm and {:.4f} deg",
-                          move.translation().norm() * 1e3,
-                          Eigen::AngleAxisf(move.linear()).angle() * 180.0 / M_PI);
+            spdlog::debug(
+                "table: refitted to every pose, the views move by {:.3f} mm and {:.4f} deg",
+                move.translation().norm() * 1e3,
+                Eigen::AngleAxisf(move.linear()).angle() * 180.0 / M_PI);
             for (SegmentedView& v : views_.views) {
                 for (Eigen::Vector3f& p : v.fusion_points) p = move * p;
                 for (Eigen::Vector3f& p : v.points) p = move * p;

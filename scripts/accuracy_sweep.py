@@ -14,8 +14,8 @@ their reported bound, and the median bound against the median error.
 With --objects parcels it draws real parcels instead, each of a kind drawn evenly: a carton
 bulging 2-6 mm (its top up to 4 mm), strapped (1-3 mm bands), labelled (0.5-2 mm), with rounded
 edges (5-20 mm), a tube standing or lying, a bag, an L-shaped pack, or a carton with a flap
-open 20-90 degrees; 12-24 poses of 2-4 frames, Kinect or RealSense noise; and the summary adds
-each kind's worst error and how many of its dimensions lie within their bounds.
+open 20-90 degrees; 12-24 poses of 2-4 frames, Kinect, RealSense or time-of-flight noise; and
+the summary adds each kind's worst error and how many of its dimensions lie within their bounds.
 
 With --objects few it draws cartons seen from 1-5 poses, evenly or unevenly spaced (the issue's
 few-poses promise: within 5 mm, or refused with its reason); with --objects pairs, two cartons
@@ -90,11 +90,15 @@ def draw_case(rng, index, seed):
 
 def parcel_station(rng, dims, render_seed, frames, distance):
     """`boxd synth` options for an object of `dims` on a station drawn for the parcel sweeps:
-    either noise model, 12-24 poses of a count of `frames`, the camera `distance` (a range)
-    away and 30-50 degrees up, the object up to 3 cm off the axis at any yaw."""
+    any of the three sensor models (a time-of-flight one's surfaces reflecting 5-60%), 12-24
+    poses of a count of `frames`, the camera `distance` (a range) away and 30-50 degrees up, the
+    object up to 3 cm off the axis at any yaw."""
     length, width, height = dims
+    noise = rng.choice(["kinect", "realsense", "tof"])
+    # A time-of-flight station's surfaces reflect from a black mat's 5% to a light top's 60%.
+    albedo = ["--multipath-albedo", f"{rng.uniform(0.05, 0.6):.2f}"] if noise == "tof" else []
     return ["--dims", f"{length:.3f}", f"{width:.3f}", f"{height:.3f}",
-            "--noise", rng.choice(["kinect", "realsense"]),
+            "--noise", noise, *albedo,
             "--poses", str(rng.choice([12, 18, 24])),
             "--frames", str(rng.choice(frames)),
             "--seed", str(render_seed),

@@ -9,19 +9,11 @@ namespace boxd {
 
 namespace {
 
-// One grid ray's surface: where it is, which way it faces and how the camera sees it.
-struct SurfaceSample {
-    bool valid = false;
-    Eigen::Vector3d point = Eigen::Vector3d::Zero();   // table frame
-    Eigen::Vector3d normal = Eigen::Vector3d::Zero();  // unit, towards the camera's side
-    double range_m = 0.0;                              // |CP|
-    double z_m = 0.0;                                  // z-depth
-    double cos_incidence = 1.0;
-    double du_inverse_z = 0.0, dv_inverse_z = 0.0;  // the plane's 1/z per pixel, along u and v
-};
-
 // A surface this much deeper or shallower than a neighbouring ray's is another surface.
 constexpr double kSameSurfaceM = 0.01;
+// A pixel lies on a sample's plane when the plane predicts its depth to this much (exact rays:
+// the curvature of a surface over a sample's spacing).
+constexpr double kOnPlaneM = 0.002;
 
 // A step of one pixel along the surface: where it goes, and how 1/z changes.
 struct Step {
@@ -43,8 +35,8 @@ Step Tangent(const SyntheticRayHit& centre, const SyntheticRayHit& before,
 
 // Returns the surface the ray through pixel (u, v) hits, its normal from the rays one pixel
 // to either side.
-SurfaceSample Sample(const SyntheticRayCaster& caster, double u, double v) {
-    SurfaceSample s;
+MultipathSurface Sample(const SyntheticRayCaster& caster, double u, double v) {
+    MultipathSurface s;
     const SyntheticRayHit c = caster.Cast(u, v);
     if (!(c.z_m > 0.0)) return s;
     const Step du = Tangent(c, caster.Cast(u - 1, v), caster.Cast(u + 1, v));
@@ -65,54 +57,6 @@ SurfaceSample Sample(const SyntheticRayCaster& caster, double u, double v) {
     return s;
 }
 
-// Returns b(P) of multipath.h as z-depth: P lit by way of every source patch.
-double ErrorAt(const SurfaceSample& p, const std::vector<const SurfaceSample*>& sources,
-               double patch_weight, double patch_px, double inverse_f) {
-    double weight = 0.0, extra = 0.0;
-    const double own = patch_weight * p.range_m * p.range_m / (M_PI * p.cos_incidence);
-    for (const SurfaceSample* q : sources) {
-        const Eigen::Vector3d d = q->point - p.point;
-        const double cos_p = p.normal.dot(d), cos_q = -q->normal.dot(d);
-        if (cos_p <= 0.0 || cos_q <= 0.0) continue;  // they do not face each other
-        // Closer than the patch's own size the patch is not a point: hold r at that size.
-        const double patch_m = patch_px * q->range_m * inverse_f;
-        const double r2 = std::max(d.squaredNorm(), patch_m * patch_m);
-        const double w = own * cos_p * cos_q / (r2 * r2);
-        weight += w;
-        extra += w * (q->range_m + std::sqrt(r2) - p.range_m);
-    }
-    const double along_ray = 0.5 * extra / (1.0 + weight);
-    return along_ray * p.z_m / p.range_m;
-}
-
-// A pixel lies on a sample's surface when the sample's plane (1/z is linear in the pixel
-// coordinates on a plane) predicts its depth to this much.
-constexpr double kOnPlaneM = 0.002;
-
-// Returns the error of pixel (x, y) of depth `zi` from the grid samples around it on its own
-// surface (bilinear), or 0 when none is.
-float Interpolate(const std::vector<SurfaceSample>& grid, const std::vector<double>& error,
-                  int gw, int gh, int stride, int x, int y, float zi) {
-    const double gx = static_cast<double>(x) / stride, gy = static_cast<double>(y) / stride;
-    const int x0 = static_cast<int>(gx), y0 = static_cast<int>(gy);
-    double sum = 0.0, weights = 0.0;
-    for (int j = 0; j < 2; ++j) {
-        for (int i = 0; i < 2; ++i) {
-            const int sx = std::min(x0 + i, gw - 1), sy = std::min(y0 + j, gh - 1);
-            const std::size_t k = static_cast<std::size_t>(sy) * gw + sx;
-            const SurfaceSample& g = grid[k];
-            if (!g.valid) continue;
-            const double predicted = 1.0 / (1.0 / g.z_m + g.du_inverse_z * (x - sx * stride) +
-                                             g.dv_inverse_z * (y - sy * stride));
-            if (!(std::abs(predicted - zi) < kOnPlaneM)) continue;
-            const double w = (i ? gx - x0 : 1.0 - (gx - x0)) * (j ? gy - y0 : 1.0 - (gy - y0));
-            sum += (w + 1e-6) * error[k];
-            weights += w + 1e-6;
-        }
-    }
-    return weights > 0.0 ? static_cast<float>(sum / weights) : 0.0f;
-}
-
 }  // namespace
 
 std::vector<float> MultipathDepthError(const SyntheticRayCaster& caster,
@@ -121,36 +65,17 @@ std::vector<float> MultipathDepthError(const SyntheticRayCaster& caster,
                                        const MultipathSampling& sampling) {
     const int w = camera.width, h = camera.height, stride = sampling.stride_px;
     const int gw = (w + stride - 1) / stride, gh = (h + stride - 1) / stride;
-    std::vector<SurfaceSample> grid(static_cast<std::size_t>(gw) * gh);
+    std::vector<MultipathSurface> grid(static_cast<std::size_t>(gw) * gh);
     for (int gy = 0; gy < gh; ++gy) {
         for (int gx = 0; gx < gw; ++gx) {
-            grid[static_cast<std::size_t>(gy) * gw + gx] =
-                Sample(caster, gx * stride, gy * stride);
+            grid[static_cast<std::size_t>(gy) * gw + gx] = Sample(caster, gx * stride, gy * stride);
         }
     }
     const int step = std::max(1, sampling.source_stride_px / stride);
-    std::vector<const SurfaceSample*> sources;
-    for (int gy = 0; gy < gh; gy += step) {
-        for (int gx = 0; gx < gw; gx += step) {
-            const SurfaceSample& s = grid[static_cast<std::size_t>(gy) * gw + gx];
-            if (s.valid) sources.push_back(&s);
-        }
-    }
-    const double patch_px = static_cast<double>(step) * stride;
-    const double inverse_f = 2.0 / (camera.fx + camera.fy);
-    const double patch_weight = albedo * patch_px * patch_px * inverse_f * inverse_f;
-    std::vector<double> error(grid.size(), 0.0);
-    for (std::size_t k = 0; k < grid.size(); ++k) {
-        if (grid[k].valid) error[k] = ErrorAt(grid[k], sources, patch_weight, patch_px, inverse_f);
-    }
-    std::vector<float> out(static_cast<std::size_t>(w) * h, 0.0f);
-    for (int y = 0; y < h; ++y) {
-        for (int x = 0; x < w; ++x) {
-            const std::size_t i = static_cast<std::size_t>(y) * w + x;
-            if (z[i] > 0.0f) out[i] = Interpolate(grid, error, gw, gh, stride, x, y, z[i]);
-        }
-    }
-    return out;
+    const std::vector<MultipathLight> errors =
+        MultipathGridErrors(grid, gw, stride, step, albedo, 0.5 * (camera.fx + camera.fy));
+    return MultipathPixelErrors(grid, errors, gw, stride, z, w, MultipathSpread::kBilinear,
+                                kOnPlaneM);
 }
 
 }  // namespace boxd

@@ -177,6 +177,7 @@ SyntheticScene MakeSyntheticScene(const SyntheticStationConfig& config) {
     truth.depth_offset_m = config.true_depth_offset_m;
     truth.depth_scale = 1.0;
     truth.focal_scale = 1.0 + config.focal_error_pct / 100.0;
+    truth.multipath_albedo = scene.noise.multipath_albedo;
     scene.true_calibration = truth;
 
     // The recorded calibration: the centre moved by the configured distance in a random

@@ -305,6 +305,21 @@ TEST(CheckEnclosingCuboid, UncertainWhenADimensionsBoundExceedsTheLimit) {
     }
 }
 
+TEST(ExplainMultipath, AnUncertainRefusalSaysHowMuchIsATimeOfFlightCamerasMultipath) {
+    MeasurementReason uncertain{ErrorCode::kUncertain, "a dimension is uncertain by 12.0 mm"};
+    ExplainMultipath(uncertain, 0.0114);
+    EXPECT_NE(uncertain.message.find("multipath correction alone is 11.4 mm"), std::string::npos)
+        << uncertain.message;
+    EXPECT_NE(uncertain.message.find("matte dark table top"), std::string::npos);
+    // Nothing to add without multipath, nor to another refusal.
+    MeasurementReason plain{ErrorCode::kUncertain, "a dimension is uncertain by 12.0 mm"};
+    ExplainMultipath(plain, 0.0);
+    EXPECT_EQ(plain.message, "a dimension is uncertain by 12.0 mm");
+    MeasurementReason unseen{ErrorCode::kInsufficientData, "a side was never seen"};
+    ExplainMultipath(unseen, 0.0114);
+    EXPECT_EQ(unseen.message, "a side was never seen");
+}
+
 TEST(CheckEnclosingCuboid, ViewConsistencyAndFlatFacesJudgeCuboidsOnly) {
     const RefusalConfig refuse;
     const std::array<double, 3> certain = {0.001, 0.001, 0.001};
