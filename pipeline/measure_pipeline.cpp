@@ -94,7 +94,7 @@ void AddTableReadings(ObjectViews& views, const std::vector<Se2>& poses, FusedCl
 // depths' rounding.
 std::array<double, 3> Bounds95(const Session& session, const FusedFit& fit,
                                const EnclosingCuboid& cuboid, const RegisteredViews& registered,
-                               const TablePlaneFit& table, double multipath_m,
+                               const TablePlaneFit& table, const MultipathShare& multipath,
                                const MeasureConfig& config) {
     // The faces' own scatter, and what the registration may still have moved them by; the
     // height is read from the table's plane, which is known as well as its poses agree.
@@ -120,13 +120,16 @@ std::array<double, 3> Bounds95(const Session& session, const FusedFit& fit,
     spdlog::debug("uncertainty: the depths' rounding {:.3f} mm in the height", rounding * 1e3);
     const double shared[3] = {moved[0], moved[1], std::hypot(table.center_se_m, rounding)};
     // A time-of-flight camera's multipath correction, trusted to within its own size
-    // (multipath_correction.h): a 95% bound of that size on every dimension.
-    const double multipath = multipath_m / kNormal95;
-    spdlog::debug("uncertainty: multipath corrections of {:.3f} mm", multipath_m * 1e3);
+    // (multipath_correction.h): a 95% bound of the walls' in the length and width, of all the
+    // object's in the height.
+    spdlog::debug("uncertainty: multipath corrections of {:.3f} mm (walls {:.3f} mm)",
+                  multipath.object_m * 1e3, multipath.walls_m * 1e3);
+    const double corrected[3] = {multipath.walls_m, multipath.walls_m, multipath.object_m};
     std::array<double, 3> uncertainty{};
     for (std::size_t i = 0; i < 3; ++i) {
         // kNormal95 sigmas: the 95% bound of SPEC section 5's uncertainty_m.
-        uncertainty[i] = kNormal95 * std::hypot(cuboid.sigma_m[i], shared[i], multipath);
+        uncertainty[i] =
+            kNormal95 * std::hypot(cuboid.sigma_m[i], shared[i], corrected[i] / kNormal95);
     }
     return uncertainty;
 }
@@ -185,12 +188,12 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
         quality.cuboid_assumed = cuboid->assumed;
         if (std::isfinite(cuboid->flatness)) quality.face_flatness = cuboid->flatness;
         uncertainty =
-            Bounds95(session, fit, *cuboid, *registered, table, stream.multipath_m(), config);
+            Bounds95(session, fit, *cuboid, *registered, table, stream.multipath(), config);
     }
     auto why = CheckEnclosingCuboid(fit, cuboid, uncertainty, refuse);
     m.out.cloud = std::move(fit.fused.points);
     if (why) {
-        ExplainMultipath(*why, stream.multipath_m());
+        ExplainMultipath(*why, std::max(stream.multipath().walls_m, stream.multipath().object_m));
         return m.Refused(*why);
     }
 

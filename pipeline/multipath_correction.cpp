@@ -25,6 +25,9 @@ constexpr double kMaxIndirectShare = 1.0 / 3.0;
 // A reading this high above the recorded table is the object's (the table plane's own
 // readings lie within its noise and calibration error of it).
 constexpr double kAboveTableM = 0.01;
+// A surface whose normal leans further than 45 degrees from the table's axis is a wall: it
+// bounds the length and width.
+constexpr double kWallFacingUp = M_SQRT1_2;
 // The fewest readings a sample's plane is fitted to.
 constexpr int kMinPlanePoints = 6;
 
@@ -166,11 +169,13 @@ namespace {
 // Every reading's multipath error (z-depth) and the share of its light that came another way.
 struct PixelLight {
     std::vector<float> error_m, share;
+    std::vector<float> facing_up;  // |the surface normal's component along the table's axis|
 };
 
 // Returns the light of every reading of the corrected depth `z` (w x h, camera frame of `lens`).
 PixelLight EstimateLight(const std::vector<float>& z, int w, int h, const CameraIntrinsics& lens,
-                         double albedo, const MultipathSampling& sampling) {
+                         const Eigen::Vector3d& table_axis, double albedo,
+                         const MultipathSampling& sampling) {
     const int stride = sampling.stride_px;
     const int gw = (w + stride - 1) / stride, gh = (h + stride - 1) / stride;
     std::vector<MultipathSurface> grid(static_cast<std::size_t>(gw) * gh);
@@ -191,6 +196,10 @@ PixelLight EstimateLight(const std::vector<float>& z, int w, int h, const Camera
     out.error_m = spread(light);
     for (MultipathLight& l : light) l.error_m = l.indirect_share;
     out.share = spread(light);
+    for (std::size_t k = 0; k < grid.size(); ++k) {
+        light[k].error_m = std::abs(grid[k].normal.dot(table_axis));
+    }
+    out.facing_up = spread(light);
     return out;
 }
 
@@ -210,13 +219,15 @@ MultipathCorrection CorrectMultipath(DepthMap raw, const CameraIntrinsics& camer
     for (float& v : read) v = v > 0.0f ? static_cast<float>(calibration.CorrectDepth(v)) : 0.0f;
     // The error is that of the true surfaces, which the readings only approach: the readings
     // less the error found from them, then once more from the surfaces that leaves.
-    PixelLight light = EstimateLight(read, w, h, lens, calibration.multipath_albedo, sampling);
+    const Eigen::Vector3d axis = calibration.table_axis.normalized();
+    const double albedo = calibration.multipath_albedo;
+    PixelLight light = EstimateLight(read, w, h, lens, axis, albedo, sampling);
     std::vector<float> z = read;
     for (std::size_t i = 0; i < z.size(); ++i)
         z[i] = read[i] > 0.0f ? read[i] - light.error_m[i] : 0.0f;
-    light = EstimateLight(z, w, h, lens, calibration.multipath_albedo, sampling);
+    light = EstimateLight(z, w, h, lens, axis, albedo, sampling);
     const Eigen::Isometry3d to_table = calibration.CameraToTable();
-    std::vector<double> above;
+    std::vector<double> above, walls;
     for (std::size_t i = 0; i < read.size(); ++i) {
         if (light.share[i] > kMaxIndirectShare) raw.z_m[i] = 0.0f;
         const float e = light.error_m[i];
@@ -226,9 +237,11 @@ MultipathCorrection CorrectMultipath(DepthMap raw, const CameraIntrinsics& camer
         const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
         const double zc = read[i] - e;
         const Eigen::Vector3d p((x - lens.cx) / lens.fx * zc, (y - lens.cy) / lens.fy * zc, zc);
-        if ((to_table * p).z() > kAboveTableM) above.push_back(e);
+        if ((to_table * p).z() <= kAboveTableM) continue;
+        above.push_back(e);
+        if (light.facing_up[i] < kWallFacingUp) walls.push_back(e);
     }
-    out.object_m = Median(std::move(above));
+    out.share = {Median(std::move(walls)), Median(std::move(above))};
     out.depth = std::move(raw);
     return out;
 }

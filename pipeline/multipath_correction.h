@@ -22,7 +22,8 @@
 // What the correction cannot know (a reflectance other than the station's, light by way of
 // surfaces outside the view or hidden from it, more than one bounce, a surface's normal from
 // readings that carry the error themselves) is carried by the bound: the correction is trusted
-// to within its own size (`MultipathCorrection::object_m`, measure_pipeline.cpp's Bounds95).
+// to within its own size (measure_pipeline.cpp's Bounds95): the walls' median correction in the
+// length and width, all the object's readings' in the height.
 
 #include <Eigen/Core>
 #include <vector>
@@ -85,10 +86,16 @@ struct MultipathSampling {
     int plane_radius_px = 3;
 };
 
+// The corrections of a view's readings above the table (as z-depth).
+struct MultipathShare {
+    double walls_m = 0.0;   // the median on surfaces steeper than 45 degrees
+    double object_m = 0.0;  // the median of all of them
+};
+
 struct MultipathCorrection {
     DepthMap depth;          // the view's raw depth with the multipath taken out
     double largest_m = 0.0;  // the largest correction of a reading, as z-depth
-    double object_m = 0.0;   // the median correction of the readings above the table
+    MultipathShare share;
 };
 
 // Returns `raw` (z-depth in metres as the camera reads it, 0 = no reading) with each reading's

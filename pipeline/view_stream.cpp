@@ -7,7 +7,6 @@
 #include <cmath>
 #include <memory>
 
-#include "pipeline/multipath_correction.h"
 #include "pipeline/parallel_for.h"
 
 namespace boxd {
@@ -109,7 +108,7 @@ ViewStream::Inspected ViewStream::Inspect(std::size_t k, PreparedPose pose) cons
     MultipathCorrection corrected =
         CorrectMultipath(std::move(*out.depth), header_.camera, header_.calibration);
     out.depth = std::move(corrected.depth);
-    out.multipath_m = corrected.object_m;
+    out.multipath = corrected.share;
     const std::size_t share = std::max<std::size_t>(
         100, std::min(kCandidatesPerPose,
                       kCandidatesInAll / std::max<std::size_t>(1, plan_deg_.size())));
@@ -125,7 +124,8 @@ bool ViewStream::Accept(std::size_t k, Inspected pose) {
         return false;
     }
     candidates_[k] = std::move(pose.candidates);
-    multipath_m_ = std::max(multipath_m_, pose.multipath_m);
+    multipath_.walls_m = std::max(multipath_.walls_m, pose.multipath.walls_m);
+    multipath_.object_m = std::max(multipath_.object_m, pose.multipath.object_m);
     pending_.push_back(std::move(*pose.depth));
     return true;
 }

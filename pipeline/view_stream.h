@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "pipeline/measure_config.h"
+#include "pipeline/multipath_correction.h"
 #include "pipeline/object_views.h"
 #include "pipeline/prepare_pose.h"
 #include "pipeline/refusal.h"
@@ -72,9 +73,9 @@ public:
     // Time spent in Add / AddAll: the table and the views, and the alignments.
     double segment_ms() const { return segment_ms_; }
     double align_ms() const { return align_ms_; }
-    // The largest of the views' median multipath corrections of their object's readings
-    // (multipath_correction.h; 0 for a camera without multipath).
-    double multipath_m() const { return multipath_m_; }
+    // The largest of the views' median multipath corrections of their object's readings, on its
+    // walls and on all of it (multipath_correction.h; 0 for a camera without multipath).
+    const MultipathShare& multipath() const { return multipath_; }
 
 private:
     // A pose looked at before it is taken: its depth (or why it is unusable) and its table
@@ -82,7 +83,7 @@ private:
     struct Inspected {
         Result<DepthMap> depth = DepthMap{};
         std::vector<Eigen::Vector3d> candidates;
-        double multipath_m = 0.0;  // the median multipath correction of the object's readings
+        MultipathShare multipath;  // the median multipath corrections of the object's readings
     };
     Inspected Inspect(std::size_t k, PreparedPose pose) const;
     // Takes pose k (its depth, its table candidates); false when it is unusable.
@@ -115,7 +116,7 @@ private:
     std::vector<PairAlignment> alignments_;  // in the order they were made
     MonotonicMs clock_;
     double segment_ms_ = 0.0, align_ms_ = 0.0;
-    double multipath_m_ = 0.0;
+    MultipathShare multipath_;
 };
 
 }  // namespace boxd

@@ -22,10 +22,11 @@ few-poses promise: within 5 mm, or refused with its reason); with --objects pair
 2-8 cm apart, which must all be refused MULTIPLE_OBJECTS.
 
 With --objects shapes it draws shapes nobody tuned to, of a kind drawn evenly: prisms and
-wedges lying on a face, frusta (cartons tapering 5-40 mm a side), pyramids, bags and lying tubes,
-on stations drawn as for the parcels; each kind is reported per sensor. For every mode the
-summary counts confident wrong numbers: a dimension whose true error is larger than twice its
-reported 95% bound plus 1 mm.
+wedges lying on a face, frusta (cartons tapering 5-40 mm a side), pyramids, bags, lying tubes,
+sacks bulging low, lying bottles, cartons on chamfered bases (5-40 mm), a small carton standing on
+a larger one and cartons with a strap looped above the top, on stations drawn as for the parcels;
+each kind is reported per sensor. For every mode the summary counts confident wrong numbers: a
+dimension whose true error is larger than twice its reported 95% bound plus 1 mm.
 
 With --effects each object also gets one effect of real cameras drawn evenly (a dark foot,
 a projector's or second imager's shadows, fattened edges, correlated noise, a fixed pattern, or
@@ -143,7 +144,8 @@ def draw_parcel(rng, index, seed):
     }
 
 
-SHAPE_KINDS = ("prism", "wedge", "frustum", "pyramid", "bag", "lying tube")
+SHAPE_KINDS = ("prism", "wedge", "frustum", "pyramid", "bag", "lying tube", "sack", "lying bottle",
+               "chamfered", "box on box", "handle")
 
 
 def draw_shape(rng, index, seed):
@@ -153,11 +155,14 @@ def draw_shape(rng, index, seed):
     length = rng.uniform(0.15, 0.5)
     width = rng.uniform(0.1, length)
     height = rng.uniform(0.06, 0.35)
-    shape = {"lying tube": "lying_cylinder"}.get(kind, kind)
+    shape = {"lying tube": "lying_cylinder", "lying bottle": "lying_bottle",
+             "box on box": "box_on_box"}.get(kind, kind)
     features = ["--shape", shape]
     if kind == "frustum":
         features += ["--taper-m", f"{rng.uniform(0.005, min(0.04, 0.3 * width)):.3f}"]
-    elif kind == "lying tube":
+    elif kind == "chamfered":
+        features += ["--taper-m", f"{rng.uniform(0.005, min(0.04, width / 4, height / 2)):.3f}"]
+    elif kind in ("lying tube", "lying bottle"):
         width = height = rng.uniform(0.06, 0.2)
     station = parcel_station(rng, (length, width, height), 1000 * seed + index, [2, 3, 4],
                              (0.85, 1.15))

@@ -315,7 +315,8 @@ void AddSynth(CLI::App& app, Runner& run) {
                     "Commanded pose angles (deg, any spacing); replaces --poses")
         ->delimiter(',');
     sub->add_option("--shape", o->shape,
-                    "box, cylinder, lying_cylinder, l_shape, bag, prism, wedge, frustum or pyramid")
+                    "box, cylinder, lying_cylinder, l_shape, bag, prism, wedge, frustum, pyramid, "
+                    "sack, lying_bottle, chamfered, box_on_box or handle")
         ->capture_default_str();
     sub->add_option("--edge-radius", o->edge_radius_m, "Rounded edges: radius (m)");
     sub->add_option("--bulge", o->bulge_m, "Side faces bulge out by this much (m)");
@@ -326,7 +327,8 @@ void AddSynth(CLI::App& app, Runner& run) {
     sub->add_option("--label", o->label_m, "A label on a side face: thickness (m)");
     sub->add_option("--flap-deg", o->flap_deg, "A top flap opened by this angle (deg)");
     sub->add_option("--taper-m", o->taper_m,
-                    "A frustum's sides come in by this much from the base to the top (m)");
+                    "A frustum's sides come in by this much from the base to the top; a "
+                    "chamfered carton's base by this much at 45 degrees (m)");
     sub->add_option("--second-dims", o->second_dims, "A second box: length, width, height (m)")
         ->expected(3);
     sub->add_option("--second-offset", o->second_offset, "The second box's centre X Y (m)")

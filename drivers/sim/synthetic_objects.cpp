@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "drivers/sim/shape_meshes.h"
+
 namespace boxd {
 
 namespace {
@@ -22,7 +24,12 @@ constexpr ShapeName kShapeNames[] = {{SyntheticShape::kBox, "box"},
                                      {SyntheticShape::kPrism, "prism"},
                                      {SyntheticShape::kWedge, "wedge"},
                                      {SyntheticShape::kFrustum, "frustum"},
-                                     {SyntheticShape::kPyramid, "pyramid"}};
+                                     {SyntheticShape::kPyramid, "pyramid"},
+                                     {SyntheticShape::kSack, "sack"},
+                                     {SyntheticShape::kLyingBottle, "lying_bottle"},
+                                     {SyntheticShape::kChamfered, "chamfered"},
+                                     {SyntheticShape::kBoxOnBox, "box_on_box"},
+                                     {SyntheticShape::kHandle, "handle"}};
 
 Eigen::Matrix3d Yaw(double rad) {
     return Eigen::AngleAxisd(rad, Eigen::Vector3d::UnitZ()).matrix();
@@ -73,7 +80,8 @@ Result<SyntheticShape> ParseSyntheticShape(const std::string& name) {
     }
     std::string names;
     for (const auto& s : kShapeNames) names += std::string(names.empty() ? "" : ", ") + s.name;
-    return Error{ErrorCode::kInvalidInput, "shape: must be one of " + names + ", got '" + name + "'"};
+    return Error{ErrorCode::kInvalidInput,
+                 "shape: must be one of " + names + ", got '" + name + "'"};
 }
 
 Status ValidateSyntheticObject(const SyntheticBox& b, const std::string& field) {
@@ -110,16 +118,29 @@ Status ValidateSyntheticObject(const SyntheticBox& b, const std::string& field) 
         return bad("shape", "edges, bulges, straps, labels and flaps belong to a box");
     }
     const bool frustum = b.shape == SyntheticShape::kFrustum;
+    const bool chamfered = b.shape == SyntheticShape::kChamfered;
     if (!std::isfinite(b.taper_m) || b.taper_m < 0.0 ||
         (frustum && !(b.taper_m > 0.0 && b.taper_m < std::min(b.length_m, b.width_m) / 2.0))) {
         return bad("taper_m", "a frustum's is in (0, half its base's smaller side)");
     }
-    if (!frustum && b.taper_m > 0.0) return bad("taper_m", "belongs to a frustum");
+    if (chamfered && !(b.taper_m > 0.0 && b.taper_m <= std::min(b.length_m, b.width_m) / 4.0 &&
+                       b.taper_m <= b.height_m / 2.0)) {
+        return bad("taper_m",
+                   "a chamfer is in (0, a quarter of the base's smaller side and half "
+                   "the height]");
+    }
+    if (!frustum && !chamfered && b.taper_m > 0.0) {
+        return bad("taper_m", "belongs to a frustum or a chamfered carton");
+    }
     if (b.shape == SyntheticShape::kCylinder && std::abs(b.length_m - b.width_m) > 1e-9) {
         return bad("width_m", "a standing cylinder's length and width are its diameter");
     }
-    if (b.shape == SyntheticShape::kLyingCylinder && std::abs(b.width_m - b.height_m) > 1e-9) {
-        return bad("height_m", "a lying cylinder's width and height are its diameter");
+    if ((b.shape == SyntheticShape::kLyingCylinder || b.shape == SyntheticShape::kLyingBottle) &&
+        std::abs(b.width_m - b.height_m) > 1e-9) {
+        return bad("height_m", "a lying cylinder's or bottle's width and height are its diameter");
+    }
+    if (b.shape == SyntheticShape::kHandle && (b.width_m < 0.03 || b.height_m < 0.06)) {
+        return bad("shape", "a carton with a handle is at least 30 mm wide and 60 mm high");
     }
     return OkStatus();
 }
@@ -154,6 +175,16 @@ TriangleMesh SyntheticObjectMesh(const SyntheticBox& b) {
             return MakeTaperedBoxMesh(l, w, h, l - 2.0 * b.taper_m, w - 2.0 * b.taper_m);
         case SyntheticShape::kPyramid:
             return MakeTaperedBoxMesh(l, w, h, 0.0, 0.0);
+        case SyntheticShape::kSack:
+            return MakeSackMesh(l, w, h);
+        case SyntheticShape::kLyingBottle:
+            return MakeLyingBottleMesh(l, w);
+        case SyntheticShape::kChamfered:
+            return MakeChamferedBoxMesh(l, w, h, b.taper_m);
+        case SyntheticShape::kBoxOnBox:
+            return MakeBoxOnBoxMesh(l, w, h);
+        case SyntheticShape::kHandle:
+            return MakeHandleBoxMesh(l, w, h);
         case SyntheticShape::kBox:
             break;
     }

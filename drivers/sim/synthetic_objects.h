@@ -1,8 +1,9 @@
 #pragma once
 // The objects of the synthetic station that are not ideal boxes — parcels as they come: rounded,
 // bulging, strapped, labelled, with an open flap; tubes standing or lying; an L-shaped pack; a
-// soft bag; a second parcel; a hand reaching in — as triangle meshes, and the smallest cuboid
-// each fits in (the answer a carrier bills, SPEC section 5).
+// soft bag; prisms, wedges, frusta, pyramids and the shapes of shape_meshes.h; a second parcel;
+// a hand reaching in — as triangle meshes, and the smallest cuboid each fits in (the answer a
+// carrier bills, SPEC section 5).
 
 #include <optional>
 #include <string>
@@ -13,7 +14,7 @@
 
 namespace boxd {
 
-// Returns "box" / "cylinder" / "lying_cylinder" / "l_shape" / "bag".
+// Returns the shape's name: "box", "cylinder", "lying_cylinder", "l_shape", "bag", "prism", ...
 const char* SyntheticShapeName(SyntheticShape shape);
 // Returns the shape named `name`, or an error naming it.
 Result<SyntheticShape> ParseSyntheticShape(const std::string& name);

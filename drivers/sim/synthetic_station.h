@@ -26,6 +26,11 @@ enum class SyntheticShape {
     kWedge,          // a wedge lying on a face: its ridge above the -width edge (a right angle)
     kFrustum,        // a tapered carton: length x width base, each side taper_m in at the top
     kPyramid,        // a pyramid on its length x width base, apex above its centre
+    kSack,           // a sack bulging low, its bottom overhanging the table (shape_meshes.h)
+    kLyingBottle,    // a bottle on its side along the length: diameter = width = height
+    kChamfered,      // a carton on a base chamfered by taper_m
+    kBoxOnBox,       // a small carton standing off centre on a larger one
+    kHandle,         // a carton with a carrying strap looped above its top
 };
 
 // An object on the table and where it stands at pose 0, in the table frame (metres, degrees).
@@ -46,7 +51,8 @@ struct SyntheticBox {
     double strap_width_m = 0.025;
     double label_thickness_m = 0.0;  // a label on the +width side
     double flap_deg = 0.0;           // a top flap hinged at the +length top edge, this far open
-    double taper_m = 0.0;            // a frustum's side comes in by this much from base to top
+    double taper_m = 0.0;            // a frustum's side comes in by this much from base to top; a
+                                     // chamfered carton's base by this much at 45 degrees
 
     // Returns true for a box without features.
     bool IsIdealBox() const {

@@ -160,4 +160,36 @@ TriangleMesh MakeCylinderMesh(double radius, double length, int segments) {
     return mesh;
 }
 
+TriangleMesh MakeLoftMesh(const std::vector<LoftRing>& rings, double exponent, int segments) {
+    TriangleMesh mesh;
+    const auto n = static_cast<std::uint32_t>(segments);
+    const double e = 2.0 / exponent;
+    for (const LoftRing& ring : rings) {
+        for (std::uint32_t k = 0; k < n; ++k) {
+            const double a = 2.0 * M_PI * k / n, c = std::cos(a), s = std::sin(a);
+            mesh.vertices.emplace_back(ring.a * std::copysign(std::pow(std::abs(c), e), c),
+                                       ring.b * std::copysign(std::pow(std::abs(s), e), s), ring.z);
+        }
+    }
+    const auto count = static_cast<std::uint32_t>(rings.size());
+    for (std::uint32_t r = 0; r + 1 < count; ++r) {
+        for (std::uint32_t k = 0; k < n; ++k) {
+            const std::uint32_t a0 = r * n + k, b0 = r * n + (k + 1) % n;
+            mesh.triangles.push_back({a0, b0, b0 + n});
+            mesh.triangles.push_back({a0, b0 + n, a0 + n});
+        }
+    }
+    // The caps: fans about each end's centre.
+    for (const std::uint32_t r : {0u, count - 1}) {
+        const auto centre = static_cast<std::uint32_t>(mesh.vertices.size());
+        mesh.vertices.emplace_back(0.0f, 0.0f, static_cast<float>(rings[r].z));
+        for (std::uint32_t k = 0; k < n; ++k) {
+            const std::uint32_t a = r * n + k, b = r * n + (k + 1) % n;
+            mesh.triangles.push_back(r == 0 ? std::array<std::uint32_t, 3>{centre, b, a}
+                                            : std::array<std::uint32_t, 3>{centre, a, b});
+        }
+    }
+    return mesh;
+}
+
 }  // namespace boxd

@@ -46,6 +46,17 @@ TriangleMesh MakeCuboidMesh(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi
 TriangleMesh MakeTaperedBoxMesh(double l, double w, double h, double top_l, double top_w,
                                 double top_dx = 0.0, double top_dy = 0.0);
 
+// One cross-section of a loft: at height z, the superellipse |x / a|^p + |y / b|^p = 1.
+struct LoftRing {
+    double z = 0.0, a = 0.0, b = 0.0;
+};
+
+// Returns the closed surface through `rings` (z increasing), each a superellipse of `exponent`
+// p (2: an ellipse, larger: squarer) of `segments` points (a multiple of 4, so that the ends of
+// its axes are among them), closed by a flat cap at either end.
+TriangleMesh MakeLoftMesh(const std::vector<LoftRing>& rings, double exponent,
+                          int segments = 144);
+
 // Returns a closed cylinder of `radius` and `length` along +z from z = 0, with `segments` sides.
 TriangleMesh MakeCylinderMesh(double radius, double length, int segments = 360);
 

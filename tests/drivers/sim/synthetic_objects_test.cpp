@@ -6,7 +6,6 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
-
 #include <cmath>
 #include <string>
 
@@ -85,14 +84,49 @@ TEST(SyntheticEnclosingCuboid, CylindersLShapeAndBag) {
     ExpectDims(SyntheticEnclosingCuboid(Shape(SyntheticShape::kBag, 0.4, 0.3, 0.2)),
                0.4 + 2 * 0.018, 0.3 + 2 * 0.018, 0.2 + 0.016, kFloatTol);
     // Shapes widest at the table: their base is the footprint, however far they taper.
-    for (SyntheticShape s : {SyntheticShape::kPrism, SyntheticShape::kWedge,
-                             SyntheticShape::kPyramid}) {
+    for (SyntheticShape s :
+         {SyntheticShape::kPrism, SyntheticShape::kWedge, SyntheticShape::kPyramid}) {
         ExpectDims(SyntheticEnclosingCuboid(Shape(s, 0.45, 0.12, 0.104)), 0.45, 0.12, 0.104,
                    kFloatTol);
     }
     SyntheticBox frustum = Shape(SyntheticShape::kFrustum, 0.4, 0.3, 0.25);
     frustum.taper_m = 0.025;
     ExpectDims(SyntheticEnclosingCuboid(frustum), 0.4, 0.3, 0.25, kFloatTol);
+}
+
+TEST(SyntheticEnclosingCuboid, ShapesThatHideTheirWidestPartFillTheirCuboid) {
+    // The sack is widest a third of the way up, the bottle across its body, the chamfered
+    // carton above its chamfer, the cartons stacked and the handle reach the top.
+    for (SyntheticShape s :
+         {SyntheticShape::kSack, SyntheticShape::kBoxOnBox, SyntheticShape::kHandle}) {
+        ExpectDims(SyntheticEnclosingCuboid(Shape(s, 0.35, 0.25, 0.3)), 0.35, 0.25, 0.3, kFloatTol);
+    }
+    ExpectDims(SyntheticEnclosingCuboid(Shape(SyntheticShape::kLyingBottle, 0.3, 0.09, 0.09)), 0.3,
+               0.09, 0.09, kFloatTol);
+    SyntheticBox chamfered = Shape(SyntheticShape::kChamfered, 0.4, 0.3, 0.25);
+    chamfered.taper_m = 0.03;
+    ExpectDims(SyntheticEnclosingCuboid(chamfered), 0.4, 0.3, 0.25, kFloatTol);
+    // Where they meet the table: the sack on 0.72 of its widest, the chamfered carton on its
+    // base less the chamfer, the bottle on a line.
+    auto footprint = [](const TriangleMesh& m) {
+        Eigen::Vector2d lo(1e9, 1e9), hi(-1e9, -1e9);
+        for (const Eigen::Vector3f& v : m.vertices) {
+            if (v.z() > 1e-6) continue;
+            lo = lo.cwiseMin(v.head<2>().cast<double>());
+            hi = hi.cwiseMax(v.head<2>().cast<double>());
+        }
+        return Eigen::Vector2d(hi - lo);
+    };
+    const Eigen::Vector2d sack =
+        footprint(SyntheticObjectMesh(Shape(SyntheticShape::kSack, 0.35, 0.25, 0.3)));
+    EXPECT_NEAR(sack.x(), 0.72 * 0.35, 1e-6);
+    EXPECT_NEAR(sack.y(), 0.72 * 0.25, 1e-6);
+    const Eigen::Vector2d base = footprint(SyntheticObjectMesh(chamfered));
+    EXPECT_NEAR(base.x(), 0.34, 1e-6);
+    EXPECT_NEAR(base.y(), 0.24, 1e-6);
+    EXPECT_LT(
+        footprint(SyntheticObjectMesh(Shape(SyntheticShape::kLyingBottle, 0.3, 0.09, 0.09))).y(),
+        1e-3);
 }
 
 // The tapered solids are closed and wound outwards: their volume by the divergence theorem is
@@ -126,7 +160,9 @@ TEST(SyntheticShapeName, RoundTripsAndABadNameIsAnErrorNamingIt) {
     for (SyntheticShape s :
          {SyntheticShape::kBox, SyntheticShape::kCylinder, SyntheticShape::kLyingCylinder,
           SyntheticShape::kLShape, SyntheticShape::kBag, SyntheticShape::kPrism,
-          SyntheticShape::kWedge, SyntheticShape::kFrustum, SyntheticShape::kPyramid}) {
+          SyntheticShape::kWedge, SyntheticShape::kFrustum, SyntheticShape::kPyramid,
+          SyntheticShape::kSack, SyntheticShape::kLyingBottle, SyntheticShape::kChamfered,
+          SyntheticShape::kBoxOnBox, SyntheticShape::kHandle}) {
         auto parsed = ParseSyntheticShape(SyntheticShapeName(s));
         ASSERT_TRUE(parsed.ok()) << SyntheticShapeName(s);
         EXPECT_EQ(*parsed, s);
@@ -179,6 +215,15 @@ TEST(ValidateSyntheticObject, NamesTheFieldOfAShapeThatIsNone) {
     b = Box(0.4, 0.3, 0.2);
     b.taper_m = 0.01;
     expect_field(b, "taper_m");
+    // A chamfer needs a size, within a quarter of the base and half the height.
+    SyntheticBox chamfered = Shape(SyntheticShape::kChamfered, 0.4, 0.3, 0.2);
+    expect_field(chamfered, "taper_m");
+    chamfered.taper_m = 0.08;
+    expect_field(chamfered, "taper_m");
+    chamfered.taper_m = 0.03;
+    EXPECT_TRUE(ValidateSyntheticObject(chamfered, "box").ok());
+    expect_field(Shape(SyntheticShape::kLyingBottle, 0.3, 0.09, 0.1), "height_m");
+    expect_field(Shape(SyntheticShape::kHandle, 0.3, 0.028, 0.2), "shape");
     expect_field(Box(0.4, 0.0, 0.2), "width_m");
 }
 
