@@ -111,6 +111,7 @@ FootReach ExtrapolateFoot(const CellGrid<LayerCell>& layer, const EnvelopeConfig
     // A wall read below its lowest judged row, too sparsely to judge (the narrow foot of a lying
     // tube's round end), or standing on something (an overhang), has no foot to extend.
     const bool at_band = layer.b0 + first * layer.db <= config.min_z_m + 1e-9;
+    out.above_band = !at_band;
     out.raised = !at_band && NothingReadBelow(layer, first, config);
     if (!at_band && !out.raised) return out;
     // The wall's profile: its lowest rows, one after another, as far as kProfileRows.

@@ -22,6 +22,10 @@ struct FootReach {
     // The wall's lowest readings stand a row or more above the band: nothing read its foot
     // (a dark or glossy base, a shadow), and the reach is extrapolated from higher up.
     bool raised = false;
+    // The wall's lowest judged row stands above the band, with readings below it too sparse to
+    // judge (stray mixed pixels, or a narrow foot): where nothing rules it out, the wall may
+    // reach as far as the table it stands on is free (foot_free_space.h).
+    bool above_band = false;
 };
 
 // Returns the foot of the outer layer `layer` (cells of (across, up), up from the table top, as

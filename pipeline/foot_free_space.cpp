@@ -79,6 +79,11 @@ void ReachBelow(const FootReach& foot, const std::vector<Eigen::Vector3f>& pts,
             reach = foot.reach;
             se = foot.se;
         }
+        // Sparse readings below the lowest judged row do not say where the wall ends: the
+        // bound reaches the free table beyond.
+        const double free =
+            foot.above_band && table != nullptr ? FreeReach(*table, pts, u) : -INFINITY;
+        if (std::isfinite(free) && free > reach) se = std::max(se, (free - reach) / kNormal95);
         return;
     }
     if (table == nullptr) return;

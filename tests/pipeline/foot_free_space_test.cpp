@@ -95,8 +95,9 @@ TEST(FootFreeSpace, ATableReadingSpreadsAlongTheTopAsItsRayFallsFlat) {
 }
 
 // A prism 300 mm long lying on a face (120 mm base, 100 mm tall) whose lowest 30 mm read
-// nothing (a dark base), 8 cameras round it, and the table read beside it (or not at all).
-Surface DarkFootedPrism(bool table_read, unsigned seed) {
+// nothing (a dark base) but `strays` mixed pixels scattered over the dark flanks, 8 cameras
+// round it, and the table read beside it (or not at all).
+Surface DarkFootedPrism(bool table_read, unsigned seed, int strays = 0) {
     constexpr double kLength = 0.3, kHalfBase = 0.06, kHeight = 0.1, kDark = 0.03;
     std::mt19937 rng(seed);
     std::normal_distribution<double> noise(0.0, 0.001);
@@ -117,6 +118,13 @@ Surface DarkFootedPrism(bool table_read, unsigned seed) {
                                       static_cast<float>(y), static_cast<float>(z));
             }
         }
+    }
+    std::uniform_real_distribution<double> along(-kLength / 2, kLength / 2), up(0.013, kDark);
+    for (int k = 0; k < strays; ++k) {
+        const double z = up(rng);
+        s.points.emplace_back(static_cast<float>(along(rng)),
+                              static_cast<float>((k % 2 ? 1.0 : -1.0) * half_width(z)),
+                              static_cast<float>(z));
     }
     for (int k = 0; k < 8; ++k) {
         const double az = 2.0 * M_PI * k / 8 + 0.1;
@@ -149,6 +157,17 @@ TEST(FootFreeSpace, ADarkFootIsBoundedByTheTableBesideIt) {
         // What the readings alone miss (36 mm) is carried, not hidden: the 95% bound covers the
         // extrapolation's error over 30 mm and the table's sparser readings (2 mm apart).
         EXPECT_LT(c->sigma_m[1], 0.01) << "seed " << seed;
+    }
+}
+
+TEST(FootFreeSpace, StrayReadingsOnADarkFootDoNotHideIt) {
+    // A few dozen mixed pixels on the dark flanks: too few to read the wall by, enough that its
+    // foot is not "nothing read"; the table beside it still bounds it.
+    for (unsigned seed = 1; seed <= 3; ++seed) {
+        const auto c =
+            EnvelopeCuboid(DarkFootedPrism(true, seed, 40), 0.001, 0.001, EnvelopeConfig{});
+        ASSERT_TRUE(c.ok()) << c.error().message;
+        EXPECT_LT(std::abs(c->width_m - 0.12), 2.0 * c->sigma_m[1] + 0.001) << "seed " << seed;
     }
 }
 
