@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "pipeline/cuboid_foot.h"
 #include "pipeline/face_envelope.h"
 #include "pipeline/single_view_cuboid.h"
 #include "pipeline/support_envelope.h"
@@ -125,7 +126,8 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     // The subsamples of the surface above the table: what the support function and a grazing
     // top's height read, and what the shape's figures (fill, top cover) read.
     const envelope::Surface surface = envelope::SurfaceAbove(cloud, config.max_points, config);
-    const envelope::Surface shape = envelope::SurfaceAbove(cloud, config.shape_points, config, false);
+    const envelope::Surface shape =
+        envelope::SurfaceAbove(cloud, config.shape_points, config, false);
     // Where no view saw a top (the box fit found too few readings on one), the top's cells hold
     // walls' ends only, spread up the walls with their rays' vertical share of the noise (a
     // fifth of the table's at a grazing top). A top some view saw has rims beside it, read with
@@ -196,7 +198,12 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
             faces[4].excess_se_m * 1e3, faces[0].offset_se_m * 1e3, faces[1].offset_se_m * 1e3,
             faces[2].offset_se_m * 1e3, faces[3].offset_se_m * 1e3, faces[4].offset_se_m * 1e3,
             c.fill, c.top_cover);
-        if (c.cuboid) return c;
+        if (c.cuboid) {
+            if (Status st = envelope::AddUnseenFeet(surface, fit, lu, lv, sigma, config, &c); !st) {
+                return st.error();
+            }
+            return c;
+        }
         face_excess = c.max_relative_excess;
     }
     // No flat faces at right angles: the support function of the surface.

@@ -102,4 +102,23 @@ void ReachBelow(const FootReach& foot, const std::vector<Eigen::Vector3f>& pts,
     se = std::max(se, std::max(free - reach, below) / kNormal95);
 }
 
+TableBeside TableBesideOf(const Surface& surface, double sigma, const EnvelopeConfig& config) {
+    // A table reading may land this many of its spreads inside the table's true edge by its
+    // noise (TableReadingSpread), so the free space beside a foot begins that much farther out:
+    // three of the few readings at the edge (FreeReach reads a strip's third nearest) all
+    // landing 1.5 spreads inside it is a chance of a few in a thousand.
+    constexpr double kTableSpreadSigmas = 1.5;
+    return TableBeside{surface.table_known ? &surface.table : nullptr,
+                       kTableSpreadSigmas * TableReadingSpread(sigma, surface.cameras),
+                       config.cell_along_m / 4.0, surface.radius};
+}
+
+Error FootUnreadRefusal() {
+    return Error{ErrorCode::kInsufficientData,
+                 "nothing was read at the foot of a side of the object, nor on the table beside "
+                 "it: how far it reaches there is unknown (a dark or glossy base, or a shadow; a "
+                 "matte label round the base, a lighter table top or a second camera angle "
+                 "helps)"};
+}
+
 }  // namespace boxd::envelope

@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "pipeline/foot_band.h"
+#include "pipeline/result.h"
+#include "pipeline/surface_cells.h"
 
 namespace boxd::envelope {
 
@@ -50,5 +52,13 @@ double FreeReach(const TableBeside& table, const std::vector<Eigen::Vector3f>& o
 void ReachBelow(const FootReach& foot, const std::vector<Eigen::Vector3f>& pts,
                 const Eigen::Vector2d& u, const TableBeside* table, double& reach, double& se,
                 bool& open);
+
+// Returns the table beside `surface` as FreeReach reads it (1.5 spreads of a table reading's
+// noise along the top for `sigma` about its plane, strips a quarter of a cell wide), or one with
+// no readings where the table was not gathered (`Surface::table_known`).
+TableBeside TableBesideOf(const Surface& surface, double sigma, const EnvelopeConfig& config);
+
+// Returns the refusal of a foot nothing read and no table reading beyond bounds.
+Error FootUnreadRefusal();
 
 }  // namespace boxd::envelope

@@ -27,12 +27,6 @@ namespace {
 // 140 degrees by 28% (24% under another registration tried): a quarter left that to chance.
 constexpr double kUnseenShare = 0.1;
 
-// A table reading may land this many of its spreads inside the table's true edge by its noise
-// (TableReadingSpread), so the free space beside a foot begins that much farther out: three of
-// the few readings at the edge (FreeReach reads a strip's third nearest) all landing 1.5
-// spreads inside it is a chance of a few in a thousand.
-constexpr double kTableSpreadSigmas = 1.5;
-
 // The outer layer's largest bound in direction (cos φ, sin φ) and in the opposite one, over
 // cells of (position across the direction, height).
 struct Support {
@@ -271,11 +265,7 @@ Result<EnclosingCuboid> CuboidOf(const Surface& surface, const LeastRectangle& r
                      "a side of the object was never seen: too few views around it to bound it"};
     }
     if (su.open_forward || su.open_backward || sv.open_forward || sv.open_backward) {
-        return Error{ErrorCode::kInsufficientData,
-                     "nothing was read at the foot of a side of the object, nor on the table "
-                     "beside it: how far it reaches there is unknown (a dark or glossy base, or "
-                     "a shadow; a matte label round the base, a lighter table top or a second "
-                     "camera angle helps)"};
+        return FootUnreadRefusal();
     }
     EnclosingCuboid c;
     const Eigen::Vector2d u(std::cos(r.phi), std::sin(r.phi)), v(-u.y(), u.x());
@@ -324,9 +314,7 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
     const std::vector<Eigen::Vector3f>& pts = surface.points;
     if (pts.empty()) return Error{ErrorCode::kInsufficientData, "no surface above the table"};
     const double radius = surface.radius, top = surface.top;
-    TableBeside table{&surface.table,
-                      kTableSpreadSigmas * TableReadingSpread(sigma, surface.cameras),
-                      config.cell_along_m / 4.0, radius};
+    const TableBeside table = TableBesideOf(surface, sigma, config);
     const TableBeside* beside = surface.table_known ? &table : nullptr;
     // A side no view faced has no facing surface: its "support" would be whatever faces that
     // way farther in (the far side's inside, a panel's back), well inside the readings of the
