@@ -14,8 +14,8 @@ their reported bound, and the median bound against the median error.
 With --objects parcels it draws real parcels instead, each of a kind drawn evenly: a carton
 bulging 2-6 mm (its top up to 4 mm), strapped (1-3 mm bands), labelled (0.5-2 mm), with rounded
 edges (5-20 mm), a tube standing or lying, a bag, an L-shaped pack, or a carton with a flap
-open 20-90 degrees; 12-24 poses of 2-4 frames, Kinect, RealSense or time-of-flight noise; and
-the summary adds each kind's worst error and how many of its dimensions lie within their bounds.
+open 20-90 degrees; 12-24 poses of 2-4 frames, Kinect or RealSense noise; and the summary adds
+each kind's worst error and how many of its dimensions lie within their bounds.
 
 With --objects few it draws cartons seen from 1-5 poses, evenly or unevenly spaced (the issue's
 few-poses promise: within 5 mm, or refused with its reason); with --objects pairs, two cartons
@@ -24,8 +24,9 @@ few-poses promise: within 5 mm, or refused with its reason); with --objects pair
 With --objects shapes it draws shapes nobody tuned to, of a kind drawn evenly: prisms and
 wedges lying on a face, frusta (cartons tapering 5-40 mm a side), pyramids, bags, lying tubes,
 sacks bulging low, lying bottles, cartons on chamfered bases (5-40 mm), a small carton standing on
-a larger one and cartons with a strap looped above the top, on stations drawn as for the parcels;
-each kind is reported per sensor. For every mode the summary counts confident wrong numbers: a
+a larger one and cartons with a strap looped above the top, on stations drawn as for the parcels
+but with a time-of-flight camera too (its station's surfaces reflecting 5-60%); each kind is
+reported per sensor. For every mode the summary counts confident wrong numbers: a
 dimension whose true error is larger than twice its reported 95% bound plus 1 mm.
 
 With --effects each object also gets one effect of real cameras drawn evenly (a dark foot,
@@ -89,13 +90,13 @@ def draw_case(rng, index, seed):
     }
 
 
-def parcel_station(rng, dims, render_seed, frames, distance):
+def parcel_station(rng, dims, render_seed, frames, distance, sensors=("kinect", "realsense")):
     """`boxd synth` options for an object of `dims` on a station drawn for the parcel sweeps:
-    any of the three sensor models (a time-of-flight one's surfaces reflecting 5-60%), 12-24
-    poses of a count of `frames`, the camera `distance` (a range) away and 30-50 degrees up, the
-    object up to 3 cm off the axis at any yaw."""
+    one of `sensors` (a time-of-flight one's surfaces reflecting 5-60%), 12-24 poses of a count
+    of `frames`, the camera `distance` (a range) away and 30-50 degrees up, the object up to 3 cm
+    off the axis at any yaw."""
     length, width, height = dims
-    noise = rng.choice(["kinect", "realsense", "tof"])
+    noise = rng.choice(list(sensors))
     # A time-of-flight station's surfaces reflect from a black mat's 5% to a light top's 60%.
     albedo = ["--multipath-albedo", f"{rng.uniform(0.05, 0.6):.2f}"] if noise == "tof" else []
     return ["--dims", f"{length:.3f}", f"{width:.3f}", f"{height:.3f}",
@@ -165,7 +166,7 @@ def draw_shape(rng, index, seed):
     elif kind in ("lying tube", "lying bottle"):
         width = height = rng.uniform(0.06, 0.2)
     station = parcel_station(rng, (length, width, height), 1000 * seed + index, [2, 3, 4],
-                             (0.85, 1.15))
+                             (0.85, 1.15), ("kinect", "realsense", "tof"))
     noise = station[station.index("--noise") + 1]
     return {"name": f"h{seed}_{index}", "kind": f"{kind} {noise}", "args": [*station, *features]}
 
