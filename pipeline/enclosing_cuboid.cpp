@@ -115,6 +115,92 @@ Status EnvelopeConfig::Validate() const {
     return OkStatus();
 }
 
+namespace {
+
+// What the face fits' cuboid is read from beside the fused cloud: its surface above the table
+// (the support function's and a grazing top's subsample, and the shape figures'), the readings'
+// noise, how closely the views agree.
+struct FaceInputs {
+    const envelope::Surface& surface;
+    const envelope::Surface& shape;
+    double sigma, height_sigma, agreement_m, noise_sigma_m;
+};
+
+void LogFaces(const std::array<envelope::FaceResult, 5>& faces, const EnclosingCuboid& c) {
+    spdlog::debug(
+        "envelope: face excess {:.2f} {:.2f} {:.2f} {:.2f} top {:.2f} mm (cell se {:.2f} {:.2f} "
+        "{:.2f} {:.2f} {:.2f}), plane se {:.2f} {:.2f} {:.2f} {:.2f} {:.2f} mm, fill {:.3f}, "
+        "top cover {:.3f}",
+        faces[0].excess_m * 1e3, faces[1].excess_m * 1e3, faces[2].excess_m * 1e3,
+        faces[3].excess_m * 1e3, faces[4].excess_m * 1e3, faces[0].excess_se_m * 1e3,
+        faces[1].excess_se_m * 1e3, faces[2].excess_se_m * 1e3, faces[3].excess_se_m * 1e3,
+        faces[4].excess_se_m * 1e3, faces[0].offset_se_m * 1e3, faces[1].offset_se_m * 1e3,
+        faces[2].offset_se_m * 1e3, faces[3].offset_se_m * 1e3, faces[4].offset_se_m * 1e3, c.fill,
+        c.top_cover);
+}
+
+// Returns the cuboid of the face fit `fit`: its faces moved out by what stands out of their
+// planes, its sides `lu` along the fit's length axis and `lv` across it; `cuboid` where its
+// faces are flat, at right angles and fill the rectangle.
+EnclosingCuboid FaceFitCuboid(const FusedCloud& cloud, const BoxFit& fit, int views,
+                              const FaceInputs& in, const EnvelopeConfig& config, double* lu,
+                              double* lv) {
+    const std::array<envelope::FaceResult, 5> faces =
+        envelope::FaceEnvelopes(cloud, fit, views, config);
+    EnclosingCuboid c;
+    for (std::size_t f = 0; f < 5; ++f) c.excess_m[f] = faces[f].excess_m;
+    const Eigen::Vector2d a = fit.length_axis, b(-a.y(), a.x());
+    *lu = fit.length_m + faces[0].excess_m + faces[1].excess_m;
+    *lv = fit.width_m + faces[2].excess_m + faces[3].excess_m;
+    c.center_m = fit.center_m + 0.5 * (faces[0].excess_m - faces[1].excess_m) * a +
+                 0.5 * (faces[2].excess_m - faces[3].excess_m) * b;
+    c.length_m = std::max(*lu, *lv);
+    c.width_m = std::min(*lu, *lv);
+    c.length_axis = *lu >= *lv ? a : b;
+    c.height_m = fit.height_m + faces[4].excess_m;
+    double top_se = 0.0;
+    if (!fit.top_observed) {
+        // No top face to fit: the height is where the side faces end.
+        c.height_m = envelope::TopBound(in.surface.points, in.sigma, in.height_sigma,
+                                        in.surface.radius, config, &top_se);
+    }
+    // Each side's excess against the box size across it: the sides against the footprint's
+    // other dimension... the face's own span is what a bulge is measured against.
+    const std::array<double, 5> span = {fit.width_m, fit.width_m, fit.length_m, fit.length_m,
+                                        std::min(fit.length_m, fit.width_m)};
+    c.flatness = 0.0;
+    for (std::size_t f = 0; f < 5; ++f) {
+        c.max_relative_excess = std::max(c.max_relative_excess, faces[f].excess_m / span[f]);
+        // A face not told (NaN) leaves the whole not told.
+        c.flatness = std::isnan(faces[f].flatness) || std::isnan(c.flatness)
+                         ? std::numeric_limits<double>::quiet_NaN()
+                         : std::max(c.flatness, faces[f].flatness);
+    }
+    // A face's position: the spread of its offset over the views, and when it stands out, the
+    // cell that says how far.
+    auto face_sigma = [&faces](std::size_t f) {
+        return std::hypot(faces[f].offset_se_m, faces[f].excess_se_m);
+    };
+    const double s_u = std::hypot(face_sigma(0), face_sigma(1));
+    const double s_v = std::hypot(face_sigma(2), face_sigma(3));
+    c.sigma_m = {*lu >= *lv ? s_u : s_v, *lu >= *lv ? s_v : s_u,
+                 fit.top_observed ? face_sigma(4) : top_se};
+    c.fill = FillRatio(in.shape, c, config);
+    c.top_cover = TopCover(in.shape, c.height_m, in.sigma, config);
+    // A flat face stands where every view sees it, up to the views' registration; a curved
+    // "face" (a tube's side) stands where each view's tangent is.
+    double spread = 0.0;
+    for (const envelope::FaceResult& f : faces) spread = std::max(spread, f.view_spread_m);
+    c.cuboid =
+        c.fill >= config.min_fill && c.top_cover >= config.min_top_cover &&
+        c.max_relative_excess <= config.max_relative_excess &&
+        spread <= config.max_view_spread_rmse * std::max(in.agreement_m, in.noise_sigma_m / 4);
+    LogFaces(faces, c);
+    return c;
+}
+
+}  // namespace
+
 Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result<BoxFit>& box,
                                            int views, double agreement_m, double noise_sigma_m,
                                            const Eigen::Vector3d& camera_m,
@@ -137,69 +223,13 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
                                     : sigma;
     double face_excess = 0.0;  // the face fit's, when it was tried: a deciding figure either way
     if (box) {
-        const BoxFit& fit = *box;
-        const std::array<envelope::FaceResult, 5> faces =
-            envelope::FaceEnvelopes(cloud, fit, views, config);
-        EnclosingCuboid c;
-        for (std::size_t f = 0; f < 5; ++f) c.excess_m[f] = faces[f].excess_m;
-        const Eigen::Vector2d a = fit.length_axis, b(-a.y(), a.x());
-        const double lu = fit.length_m + faces[0].excess_m + faces[1].excess_m;
-        const double lv = fit.width_m + faces[2].excess_m + faces[3].excess_m;
-        c.center_m = fit.center_m + 0.5 * (faces[0].excess_m - faces[1].excess_m) * a +
-                     0.5 * (faces[2].excess_m - faces[3].excess_m) * b;
-        c.length_m = std::max(lu, lv);
-        c.width_m = std::min(lu, lv);
-        c.length_axis = lu >= lv ? a : b;
-        c.height_m = fit.height_m + faces[4].excess_m;
-        double top_se = 0.0;
-        if (!fit.top_observed) {
-            // No top face to fit: the height is where the side faces end.
-            c.height_m = envelope::TopBound(surface.points, sigma, height_sigma, surface.radius,
-                                            config, &top_se);
-        }
-        // Each side's excess against the box size across it: the sides against the footprint's
-        // other dimension... the face's own span is what a bulge is measured against.
-        const std::array<double, 5> span = {fit.width_m, fit.width_m, fit.length_m, fit.length_m,
-                                            std::min(fit.length_m, fit.width_m)};
-        c.flatness = 0.0;
-        for (std::size_t f = 0; f < 5; ++f) {
-            c.max_relative_excess = std::max(c.max_relative_excess, faces[f].excess_m / span[f]);
-            // A face not told (NaN) leaves the whole not told.
-            c.flatness = std::isnan(faces[f].flatness) || std::isnan(c.flatness)
-                             ? std::numeric_limits<double>::quiet_NaN()
-                             : std::max(c.flatness, faces[f].flatness);
-        }
-        // A face's position: the spread of its offset over the views, and when it stands out,
-        // the cell that says how far.
-        auto face_sigma = [&faces](std::size_t f) {
-            return std::hypot(faces[f].offset_se_m, faces[f].excess_se_m);
-        };
-        const double s_u = std::hypot(face_sigma(0), face_sigma(1));
-        const double s_v = std::hypot(face_sigma(2), face_sigma(3));
-        c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u,
-                     fit.top_observed ? face_sigma(4) : top_se};
-        c.fill = FillRatio(shape, c, config);
-        c.top_cover = TopCover(shape, c.height_m, sigma, config);
-        // A flat face stands where every view sees it, up to the views' registration; a curved
-        // "face" (a tube's side) stands where each view's tangent is.
-        double spread = 0.0;
-        for (const envelope::FaceResult& f : faces) spread = std::max(spread, f.view_spread_m);
-        c.cuboid = c.fill >= config.min_fill && c.top_cover >= config.min_top_cover &&
-                   c.max_relative_excess <= config.max_relative_excess &&
-                   spread <= config.max_view_spread_rmse * std::max(agreement_m, noise_sigma_m / 4);
-        spdlog::debug(
-            "envelope: face excess {:.2f} {:.2f} {:.2f} {:.2f} top {:.2f} mm (cell se {:.2f} "
-            "{:.2f} "
-            "{:.2f} {:.2f} {:.2f}), plane se {:.2f} {:.2f} {:.2f} {:.2f} {:.2f} mm, fill {:.3f}, "
-            "top cover {:.3f}",
-            faces[0].excess_m * 1e3, faces[1].excess_m * 1e3, faces[2].excess_m * 1e3,
-            faces[3].excess_m * 1e3, faces[4].excess_m * 1e3, faces[0].excess_se_m * 1e3,
-            faces[1].excess_se_m * 1e3, faces[2].excess_se_m * 1e3, faces[3].excess_se_m * 1e3,
-            faces[4].excess_se_m * 1e3, faces[0].offset_se_m * 1e3, faces[1].offset_se_m * 1e3,
-            faces[2].offset_se_m * 1e3, faces[3].offset_se_m * 1e3, faces[4].offset_se_m * 1e3,
-            c.fill, c.top_cover);
+        double lu = 0.0, lv = 0.0;
+        EnclosingCuboid c = FaceFitCuboid(
+            cloud, *box, views, {surface, shape, sigma, height_sigma, agreement_m, noise_sigma_m},
+            config, &lu, &lv);
         if (c.cuboid) {
-            if (Status st = envelope::AddUnseenFeet(surface, fit, lu, lv, sigma, config, &c); !st) {
+            if (Status st = envelope::AddUnseenFeet(surface, *box, lu, lv, sigma, config, &c);
+                !st) {
                 return st.error();
             }
             return c;
