@@ -52,6 +52,10 @@ void CheckContents(const fs::path& deb, const fs::path& root) {
         {"./usr/share/boxd/config/boxd.yaml", "-rw-r--r--"},
         {"./usr/share/boxd/config/sim.yaml", "-rw-r--r--"},
         {"./usr/share/boxd/web/index.html", "-rw-r--r--"},
+        // The README and the documentation it links.
+        {"./usr/share/doc/boxd/README.md", "-rw-r--r--"},
+        {"./usr/share/doc/boxd/docs/station.md", "-rw-r--r--"},
+        {"./usr/share/doc/boxd/docs/findings/README.md", "-rw-r--r--"},
     };
     for (const auto& e : expected) {
         const std::regex line(std::string("(^|\\n)") + e.mode + R"( root/root +\d+ \S+ \S+ )" +
