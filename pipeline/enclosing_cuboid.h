@@ -62,7 +62,7 @@ struct EnvelopeConfig {
     int directions = 180;             // footprint orientations over 180 degrees (irregular)
     // The support function reads at most max_points readings (an even subsample beyond), where
     // a 0.5 m object's 12 mm cells hold about a hundred each: a cap ten times smaller starved a
-    // curved side's crest on a noisy sensor, its cells too thin to be judged (README).
+    // curved side's crest on a noisy sensor, its cells too thin to be judged (docs/measuring.md).
     int max_points = 400000;
     int threads = 2;  // the support function's directions
     // The footprint's fill and the top's cover read an even subsample of at most shape_points

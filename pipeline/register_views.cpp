@@ -39,7 +39,7 @@ Result<RegisteredViews> SolveViewGraph(std::vector<PoseEdge> edges, const EdgeSt
     // centre along the line of sight (against the true poses of synthetic stations without
     // calibration or turntable errors, the rest moves it by under 0.003 mm), and the ICP edges
     // lean that centre by up to twice its sigma from the graph, the same way on every capture
-    // of a station, with the sensor's noise (README, Known limits). The graph's own
+    // of a station, with the sensor's noise (docs/limits.md). The graph's own
     // covariance matches the edges' random errors: their whitened errors against the truth
     // have RMS 0.99-1.06 across and along the line of sight. A view's own error entering every
     // edge aligned onto it, modelled as such, comes out at 0.01-0.015 mm and leaves the

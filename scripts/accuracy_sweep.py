@@ -175,7 +175,7 @@ EFFECTS = ("none", "dark foot", "shadow", "fattening", "correlated", "fixed patt
 
 
 def draw_effect(rng, case):
-    """Adds one effect of real cameras, drawn evenly (README, sensor effects), to `case`:
+    """Adds one effect of real cameras, drawn evenly (docs/measuring.md, sensor effects), to `case`:
     a base reading no depth 10-40 mm up, the shadows of a projector (Kinect, 75 mm either side)
     or a second imager (RealSense, 50 mm to the right), edges fattened 1-4 pixels, correlated
     noise of 0.5-2 mm, or a fixed pattern of 0.5-3 mm (both at 1 m)."""

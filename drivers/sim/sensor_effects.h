@@ -1,7 +1,7 @@
 #pragma once
 // The effects of real depth cameras that the synthetic station adds to its noise models when
-// asked (SensorNoiseParams, `boxd synth` options; the README's sensor-effects table gives each
-// one's physical cause and the published figures it follows):
+// asked (SensorNoiseParams, `boxd synth` options; docs/measuring.md's sensor-effects table gives
+// each one's physical cause and the published figures it follows):
 //   - shadows: a structured-light camera reads a point only where its projector lights it, a
 //     stereo camera only where both imagers see it; beside an object's silhouette, on the side
 //     away from the second viewpoint, the table reads nothing (RenderDepthFrame casts the

@@ -259,7 +259,7 @@ TEST(Accuracy, SyntheticSuiteWithinTolerance) {
             calibrated[2], RmsStandardised(box_errors[k], box_bounds[k]));
     }
     std::printf("\n");
-    // SPEC section 5's bound holds for 95% of the dimensions (the README's accuracy section
+    // SPEC section 5's bound holds for 95% of the dimensions (docs/measuring.md's accuracy suite
     // names the misses: biases of the methods that no spread of the data shows).
     EXPECT_GE(covered, judged * 95 / 100) << "uncertainty coverage fell";
     for (const Outcome& o : outcomes) {

@@ -138,7 +138,7 @@ TEST(OpenNi2Camera, RecordingOfTheDummyDeviceReadsBack) {
     EXPECT_LE(*count, kFrames + 2);
 
     // Playback must never hang: a frame or a CAMERA_ERROR within the timeout. (Debian's
-    // OniFile player may not deliver frames at all; see the README.)
+    // OniFile player may not deliver frames at all; see docs/station.md.)
     const auto start = std::chrono::steady_clock::now();
     auto frame = camera.Grab(milliseconds(1000));
     EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));

@@ -317,14 +317,14 @@ TEST(FitEnclosingCuboid, LShapeIsIrregularAtTwoAndAHalfMillimetresOfNoise) {
     // The support function at 2.5 mm of noise reads the inner corner's sides wide: +2.3 mm in
     // the gcc build, +3.0 mm in the clang one (scripts/dev.sh sanitize), from nothing but
     // floating-point rounding — the extremes of this much noise are that unstable. A known
-    // limit of irregular shapes on noisy clouds (README, accuracy), held here to 3.5 mm.
+    // limit of irregular shapes on noisy clouds (docs/measuring.md), held here to 3.5 mm.
     EXPECT_NEAR(f.cuboid->length_m, l, 0.0035);
     EXPECT_NEAR(f.cuboid->width_m, w, 0.0035);
 }
 
 TEST(FitEnclosingCuboid, LShapesLeanOverSeedsStaysWithinTheIrregularTolerance) {
     // The support function reads this hand-made L's flat faces outside themselves by about half
-    // a millimetre (README, Known limits), more on every reading than on the 40,000 of the shape's
+    // a millimetre (docs/limits.md), more on every reading than on the 40,000 of the shape's
     // figures: printed over 20 seeds on both. Each dimension must stay within the irregular
     // shapes' 3 mm (at 2.5 mm of noise the turned rectangles' averaging read one L 4-6 mm large:
     // LShapeIsIrregularAtTwoAndAHalfMillimetresOfNoise).
@@ -388,7 +388,6 @@ TEST(FitEnclosingCuboid, ThinCloudIsInsufficientDataWithoutABox) {
                            kShiftAgreement, kSigma, kOverhead, EnvelopeConfig{}),
         ErrorCode::kInsufficientData);
 }
-
 
 TEST(EnvelopeConfig, ValidateNamesTheField) {
     EXPECT_TRUE(EnvelopeConfig{}.Validate().ok());
