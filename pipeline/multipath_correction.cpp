@@ -205,6 +205,20 @@ PixelLight EstimateLight(const std::vector<float>& z, int w, int h, const Camera
 
 }  // namespace
 
+// The samples of a VGA image at the sampling's strides: the sum costs their count times the
+// sources', so a larger image is sampled as coarsely as one of this many pixels.
+constexpr double kSampledPixels = 640.0 * 480.0;
+
+MultipathSampling ScaledSampling(const MultipathSampling& sampling, int w, int h) {
+    const double scale = std::sqrt(static_cast<double>(w) * h / kSampledPixels);
+    if (!(scale > 1.0)) return sampling;
+    MultipathSampling out = sampling;
+    out.stride_px = static_cast<int>(std::ceil(sampling.stride_px * scale));
+    out.source_stride_px =
+        out.stride_px * std::max(1, sampling.source_stride_px / sampling.stride_px);
+    return out;
+}
+
 MultipathCorrection CorrectMultipath(DepthMap raw, const CameraIntrinsics& camera,
                                      const StationCalibration& calibration,
                                      const MultipathSampling& sampling) {
@@ -221,11 +235,12 @@ MultipathCorrection CorrectMultipath(DepthMap raw, const CameraIntrinsics& camer
     // less the error found from them, then once more from the surfaces that leaves.
     const Eigen::Vector3d axis = calibration.table_axis.normalized();
     const double albedo = calibration.multipath_albedo;
-    PixelLight light = EstimateLight(read, w, h, lens, axis, albedo, sampling);
+    const MultipathSampling scaled = ScaledSampling(sampling, w, h);
+    PixelLight light = EstimateLight(read, w, h, lens, axis, albedo, scaled);
     std::vector<float> z = read;
     for (std::size_t i = 0; i < z.size(); ++i)
         z[i] = read[i] > 0.0f ? read[i] - light.error_m[i] : 0.0f;
-    light = EstimateLight(z, w, h, lens, axis, albedo, sampling);
+    light = EstimateLight(z, w, h, lens, axis, albedo, scaled);
     const Eigen::Isometry3d to_table = calibration.CameraToTable();
     std::vector<double> above, walls;
     for (std::size_t i = 0; i < read.size(); ++i) {

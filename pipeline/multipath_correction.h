@@ -79,12 +79,17 @@ std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& gri
 // The sampling of the sum: the error is smooth on each surface, so it is evaluated every
 // `stride_px` pixels (each sample's surface from a plane through the readings within
 // `plane_radius_px`) with light from every `source_stride_px`-th pixel, and each reading takes
-// it from the samples around it on its own surface.
+// it from the samples around it on its own surface. Images larger than VGA are sampled no more
+// densely than a VGA one (the sum's cost grows as the square of the samples).
 struct MultipathSampling {
     int stride_px = 8;
     int source_stride_px = 16;
     int plane_radius_px = 3;
 };
+
+// Returns `sampling` with its strides widened so that a w x h image has no more samples than a
+// VGA one (unchanged up to VGA).
+MultipathSampling ScaledSampling(const MultipathSampling& sampling, int w, int h);
 
 // The corrections of a view's readings above the table (as z-depth).
 struct MultipathShare {

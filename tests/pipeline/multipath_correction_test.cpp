@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <utility>
 #include <vector>
 
 #include "drivers/sim/synthetic_station.h"
@@ -71,6 +72,23 @@ TEST(MultipathCorrection, AViewCorrectedFromItsOwnReadingsComesBackToTheTruth) {
     EXPECT_LT(corrected.share.object_m, corrected.largest_m);
     // The box's walls are corrected more than its top, which nothing lights.
     EXPECT_GT(corrected.share.walls_m, corrected.share.object_m);
+}
+
+TEST(MultipathCorrection, ALargerImageIsSampledNoMoreDenselyThanAVgaOne) {
+    const MultipathSampling vga;
+    for (auto [w, h] : {std::pair{640, 480}, std::pair{320, 240}}) {
+        const MultipathSampling same = ScaledSampling(vga, w, h);
+        EXPECT_EQ(same.stride_px, vga.stride_px);
+        EXPECT_EQ(same.source_stride_px, vga.source_stride_px);
+    }
+    // Four times the pixels: strides twice as wide, the same count of samples and sources.
+    const MultipathSampling twice = ScaledSampling(vga, 1280, 960);
+    EXPECT_EQ(twice.stride_px, 2 * vga.stride_px);
+    EXPECT_EQ(twice.source_stride_px, 2 * vga.source_stride_px);
+    // The largest a session may hold (8192 x 8192) stays within a VGA image's count.
+    const MultipathSampling largest = ScaledSampling(vga, 8192, 8192);
+    const double samples = (8192.0 / largest.stride_px) * (8192.0 / largest.stride_px);
+    EXPECT_LE(samples, (640.0 / vga.stride_px) * (480.0 / vga.stride_px));
 }
 
 TEST(MultipathCorrection, ACameraWithoutMultipathIsLeftAlone) {
