@@ -193,7 +193,7 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
     auto why = CheckEnclosingCuboid(fit, cuboid, uncertainty, refuse);
     m.out.cloud = std::move(fit.fused.points);
     if (why) {
-        ExplainMultipath(*why, std::max(stream.multipath().walls_m, stream.multipath().object_m));
+        ExplainMultipath(*why, stream.multipath().Largest());
         return m.Refused(*why);
     }
 

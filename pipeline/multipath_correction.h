@@ -26,6 +26,7 @@
 // length and width, all the object's readings' in the height.
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <vector>
 
 #include "pipeline/camera.h"
@@ -95,6 +96,13 @@ MultipathSampling ScaledSampling(const MultipathSampling& sampling, int w, int h
 struct MultipathShare {
     double walls_m = 0.0;   // the median on surfaces steeper than 45 degrees
     double object_m = 0.0;  // the median of all of them
+
+    // Takes the larger of each from `other` (the views' largest).
+    void Widen(const MultipathShare& other) {
+        walls_m = std::max(walls_m, other.walls_m);
+        object_m = std::max(object_m, other.object_m);
+    }
+    double Largest() const { return std::max(walls_m, object_m); }
 };
 
 struct MultipathCorrection {

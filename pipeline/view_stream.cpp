@@ -98,6 +98,7 @@ std::unique_ptr<ViewStream> ViewStream::SoFar() const {
     std::copy(views_.clouds.begin(), views_.clouds.begin() + static_cast<long>(n),
               copy->views_.clouds.begin());
     copy->alignments_ = alignments_;
+    copy->multipath_ = multipath_;
     return copy;
 }
 
@@ -124,8 +125,7 @@ bool ViewStream::Accept(std::size_t k, Inspected pose) {
         return false;
     }
     candidates_[k] = std::move(pose.candidates);
-    multipath_.walls_m = std::max(multipath_.walls_m, pose.multipath.walls_m);
-    multipath_.object_m = std::max(multipath_.object_m, pose.multipath.object_m);
+    multipath_.Widen(pose.multipath);
     pending_.push_back(std::move(*pose.depth));
     return true;
 }

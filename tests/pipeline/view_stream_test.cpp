@@ -48,6 +48,27 @@ TEST(ViewStream, OneByOneMeasuresExactlyAsAllAtOnce) {
     EXPECT_EQ(stats.attempted, 16);
 }
 
+TEST(ViewStream, ACopySoFarKeepsTheMultipathItsBoundCarries) {
+    // A time-of-flight station: the poses so far, measured while the capture goes on (the early
+    // stop), carry the same multipath correction in their bounds as the whole stream.
+    SyntheticStationConfig c;
+    c.box = {0.3, 0.2, 0.15};
+    c.noise = NoiseModel::kToF;
+    c.seed = 24;
+    auto session = RenderSyntheticSession(c, 4, 1);
+    ASSERT_TRUE(session.ok());
+    ASSERT_GT(session->calibration.multipath_albedo, 0.0);
+    const MeasureConfig config;
+    ViewStream stream(*session, session->PoseAnglesDeg(), config);
+    std::vector<PreparedPose> prepared = PrepareSession(*session, config);
+    for (int i = 0; i < 3; ++i) stream.Add(std::move(prepared[static_cast<std::size_t>(i)]));
+    ASSERT_GT(stream.multipath().walls_m, 0.0);
+    const std::unique_ptr<ViewStream> copy = stream.SoFar();
+    ASSERT_NE(copy, nullptr);
+    EXPECT_EQ(copy->multipath().walls_m, stream.multipath().walls_m);
+    EXPECT_EQ(copy->multipath().object_m, stream.multipath().object_m);
+}
+
 TEST(ViewStream, AnUnusablePoseIsRefusedByNameWhateverFollows) {
     const Session session = Render(22, 4);
     const MeasureConfig config;
