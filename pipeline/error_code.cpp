@@ -42,6 +42,8 @@ int HttpStatusOf(ErrorCode code) {
             return 401;
         case ErrorCategory::kNotFound:
             return 404;
+        case ErrorCategory::kMethodNotAllowed:
+            return 405;
         case ErrorCategory::kConflict:
             return 409;
         case ErrorCategory::kTooLarge:

@@ -15,6 +15,7 @@ enum class ErrorCategory {
     kBadInput,            // the caller's input or configuration is invalid: 400, exit 2
     kUnauthorized,        // a request without a valid token: 401
     kNotFound,            // no such route, measurement or file: 404
+    kMethodNotAllowed,    // a known path asked with a method it does not serve: 405
     kConflict,            // the station is busy: 409
     kTooLarge,            // a request body over the limit: 413
     kNoDimension,         // measured, but no size the data supports (status no_dim): 422, exit 3
@@ -34,6 +35,7 @@ enum class ErrorCategory {
     X(kBadRequest, "BAD_REQUEST", kBadInput)                      \
     X(kUnauthorized, "UNAUTHORIZED", kUnauthorized)               \
     X(kNotFound, "NOT_FOUND", kNotFound)                          \
+    X(kMethodNotAllowed, "METHOD_NOT_ALLOWED", kMethodNotAllowed) \
     X(kBusy, "BUSY", kConflict)                                   \
     X(kPayloadTooLarge, "PAYLOAD_TOO_LARGE", kTooLarge)           \
     X(kNoObject, "NO_OBJECT", kNoDimension)                       \

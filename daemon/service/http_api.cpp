@@ -72,10 +72,81 @@ Status SetSocketAccess(const std::string& path, const std::string& mode, const s
     return OkStatus();
 }
 
+// Runs before routing (and before the body is read): the body length, the range limit, the
+// bearer token.
+httplib::Server::HandlerResponse PreRoute(const ServerConfig& config, const Request& req,
+                                          Response& res) {
+    // A request without Content-Length or Transfer-Encoding has no body (RFC 9112 6.3), but
+    // httplib 0.11 would wait for the client to close the connection (what `curl -X POST`
+    // without data never does). Saying so in the headers makes it read an empty body. The
+    // Request is httplib's own non-const object, handed to us as const.
+    if (!req.has_header("Content-Length") && !req.has_header("Transfer-Encoding")) {
+        const_cast<Request&>(req).headers.emplace("Content-Length", "0");
+    }
+    // httplib 0.11 builds a multipart answer to a multi-range request in memory, each range
+    // a full copy: a few hundred ranges of one cloud would take gigabytes.
+    if (CountRanges(req.get_header_value("Range")) > kMaxRanges) {
+        const_cast<Request&>(req).ranges.clear();  // the refusal itself is sent whole
+        SetError(res, 416, ErrorCode::kBadRequest,
+                 "at most " + std::to_string(kMaxRanges) + " byte ranges per request");
+        return httplib::Server::HandlerResponse::Handled;
+    }
+    // The bearer token guards every POST (and every request with protect_reads), before
+    // routing and before the body is read.
+    const bool guarded = req.method == "POST" || config.protect_reads;
+    if (!guarded || config.bearer_token.empty()) {
+        return httplib::Server::HandlerResponse::Unhandled;
+    }
+    const std::string auth = req.get_header_value("Authorization");
+    const std::string prefix = "Bearer ";
+    if (auth.rfind(prefix, 0) == 0 &&
+        TokenEquals(auth.substr(prefix.size()), config.bearer_token)) {
+        return httplib::Server::HandlerResponse::Unhandled;
+    }
+    res.set_header("WWW-Authenticate", "Bearer");
+    SetError(res, ErrorCode::kUnauthorized,
+             std::string(config.protect_reads ? "requests" : "POST requests") +
+                 " need a valid bearer token");
+    return httplib::Server::HandlerResponse::Handled;
+}
+
+// Gives any error status a handler left without a body (an unknown route 404, an oversize body
+// 413, an unreadable request 400) the JSON error form; a known path asked with a method it does
+// not serve is 405 with the methods it does in Allow.
+httplib::Server::HandlerResponse AnswerError(const RouteTable& routes, const Request& req,
+                                             Response& res) {
+    if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+    switch (res.status) {
+        case 404: {
+            const std::string allowed = routes.AllowedMethods(req.path);
+            if (allowed.empty()) {
+                SetError(res, ErrorCode::kNotFound, "no route " + req.method + " " + req.path);
+                break;
+            }
+            res.set_header("Allow", allowed);
+            SetError(res, ErrorCode::kMethodNotAllowed,
+                     req.path + " answers " + allowed + ", not " + req.method);
+            break;
+        }
+        case 413:
+            SetError(res, ErrorCode::kPayloadTooLarge, "the request body is too large");
+            break;
+        case 400:
+            SetError(res, ErrorCode::kBadRequest, "malformed request");
+            break;
+        default:
+            // Statuses the HTTP library sets itself (a range it cannot serve, a URI too long):
+            // the status stays, the code is the category's.
+            SetError(res, res.status, res.status < 500 ? ErrorCode::kBadRequest : ErrorCode::kInternal,
+                     "the request failed with HTTP status " + std::to_string(res.status));
+    }
+    return httplib::Server::HandlerResponse::Handled;
+}
+
 }  // namespace
 
-void AddStatusRoutes(httplib::Server& server, const ApiContext& api) {
-    server.Get("/v1/health", Guarded([api](const Request&, Response& res) {
+void AddStatusRoutes(RouteTable& routes, const ApiContext& api) {
+    routes.Get("/v1/health", Guarded([api](const Request&, Response& res) {
                    if (api.loop_alive && !api.loop_alive()) {
                        SetError(res, ErrorCode::kLoopStalled, "the service loop does not respond");
                        return;
@@ -83,7 +154,7 @@ void AddStatusRoutes(httplib::Server& server, const ApiContext& api) {
                    SetJson(res, 200, json{{"status", "ok"}});
                }));
 
-    server.Get("/v1/status", Guarded([api](const Request&, Response& res) {
+    routes.Get("/v1/status", Guarded([api](const Request&, Response& res) {
                    const ServiceSnapshot snapshot = api.service.Snapshot();
                    const std::shared_ptr<Station> station = api.service.station();
                    const long long uptime_s = UptimeSeconds();
@@ -92,13 +163,13 @@ void AddStatusRoutes(httplib::Server& server, const ApiContext& api) {
                        StatusJson(snapshot, station->Devices(), station->Calibration(), uptime_s));
                }));
 
-    server.Get("/v1/openapi.json", Guarded([](const Request&, Response& res) {
+    routes.Get("/v1/openapi.json", Guarded([](const Request&, Response& res) {
                    res.status = 200;
                    res.set_content(OpenApiDocument(), "application/json");
                }));
 
     // The Prometheus exposition (service_metrics.h); GETs need the token only with protect_reads.
-    server.Get("/metrics", Guarded([api](const Request&, Response& res) {
+    routes.Get("/metrics", Guarded([api](const Request&, Response& res) {
                    const std::shared_ptr<Station> station = api.service.station();
                    const CalibrationInForce calibration = station->Calibration();
                    MetricsContext context;
@@ -138,65 +209,11 @@ void HttpApi::Register(httplib::Server& server) {
     });
     server.set_read_timeout(10, 0);
     server.set_write_timeout(10, 0);
-
-    // Runs before routing (and before the body is read): the bearer token guards every POST.
-    server.set_pre_routing_handler([this](const Request& req, Response& res) {
-        // A request without Content-Length or Transfer-Encoding has no body (RFC 9112 6.3), but
-        // httplib 0.11 would wait for the client to close the connection (what `curl -X POST`
-        // without data never does). Saying so in the headers makes it read an empty body. The
-        // Request is httplib's own non-const object, handed to us as const.
-        if (!req.has_header("Content-Length") && !req.has_header("Transfer-Encoding")) {
-            const_cast<Request&>(req).headers.emplace("Content-Length", "0");
-        }
-        // httplib 0.11 builds a multipart answer to a multi-range request in memory, each range
-        // a full copy: a few hundred ranges of one cloud would take gigabytes.
-        if (CountRanges(req.get_header_value("Range")) > kMaxRanges) {
-            const_cast<Request&>(req).ranges.clear();  // the refusal itself is sent whole
-            SetError(res, 416, ErrorCode::kBadRequest,
-                     "at most " + std::to_string(kMaxRanges) + " byte ranges per request");
-            return httplib::Server::HandlerResponse::Handled;
-        }
-        const bool guarded = req.method == "POST" || config_.protect_reads;
-        if (!guarded || config_.bearer_token.empty()) {
-            return httplib::Server::HandlerResponse::Unhandled;
-        }
-        const std::string auth = req.get_header_value("Authorization");
-        const std::string prefix = "Bearer ";
-        if (auth.rfind(prefix, 0) == 0 &&
-            TokenEquals(auth.substr(prefix.size()), config_.bearer_token)) {
-            return httplib::Server::HandlerResponse::Unhandled;
-        }
-        res.set_header("WWW-Authenticate", "Bearer");
-        SetError(res, ErrorCode::kUnauthorized,
-                 std::string(config_.protect_reads ? "requests" : "POST requests") +
-                     " need a valid bearer token");
-        return httplib::Server::HandlerResponse::Handled;
-    });
-
-    // Any error status a handler left without a body (unknown route 404, oversize body 413,
-    // unreadable request 400) gets the JSON error form too.
-    server.set_error_handler(
-        httplib::Server::HandlerWithResponse([](const Request& req, Response& res) {
-            if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
-            switch (res.status) {
-                case 404:
-                    SetError(res, ErrorCode::kNotFound, "no route " + req.method + " " + req.path);
-                    break;
-                case 413:
-                    SetError(res, ErrorCode::kPayloadTooLarge, "the request body is too large");
-                    break;
-                case 400:
-                    SetError(res, ErrorCode::kBadRequest, "malformed request");
-                    break;
-                default:
-                    // Statuses the HTTP library sets itself (a range it cannot serve, a URI
-                    // too long): the status stays, the code is the category's.
-                    SetError(res, res.status,
-                             res.status < 500 ? ErrorCode::kBadRequest : ErrorCode::kInternal,
-                             "the request failed with HTTP status " + std::to_string(res.status));
-            }
-            return httplib::Server::HandlerResponse::Handled;
-        }));
+    server.set_pre_routing_handler(
+        [this](const Request& req, Response& res) { return PreRoute(config_, req, res); });
+    auto routes = std::make_shared<RouteTable>(server);
+    server.set_error_handler(httplib::Server::HandlerWithResponse(
+        [routes](const Request& req, Response& res) { return AnswerError(*routes, req, res); }));
     server.set_exception_handler([](const Request&, Response& res, std::exception_ptr) {
         SetError(res, ErrorCode::kInternal, "internal failure");
     });
@@ -205,10 +222,10 @@ void HttpApi::Register(httplib::Server& server) {
     });
 
     const ApiContext api{config_, service_, store_, loop_alive_, mqtt_stats_};
-    AddStatusRoutes(server, api);
-    AddMeasurementRoutes(server, api);
-    AddCalibrationRoutes(server, api);
-    AddPageRoutes(server, api);
+    AddStatusRoutes(*routes, api);
+    AddMeasurementRoutes(*routes, api);
+    AddCalibrationRoutes(*routes, api);
+    AddPageRoutes(*routes, api);
 }
 
 Status HttpApi::Start() {

@@ -34,9 +34,9 @@ std::optional<BoxDimensions> ReferenceOf(const json& body, Response& res) {
 
 }  // namespace
 
-void AddCalibrationRoutes(httplib::Server& server, const ApiContext& api) {
-    server.Post("/v1/calibrate", Guarded([api](const Request& req, Response& res) {
-                    std::optional<json> body = JsonObjectBody(req, res, true);
+void AddCalibrationRoutes(RouteTable& routes, const ApiContext& api) {
+    routes.Post("/v1/calibrate", Guarded([api](const Request& req, Response& res) {
+                    std::optional<json> body = JsonObjectBody(req, res, true, {"reference_m"});
                     if (!body) return;
                     const std::optional<BoxDimensions> reference = ReferenceOf(*body, res);
                     if (!reference) return;
@@ -51,7 +51,7 @@ void AddCalibrationRoutes(httplib::Server& server, const ApiContext& api) {
                     }
                 }));
 
-    server.Get("/v1/calibration", Guarded([api](const Request&, Response& res) {
+    routes.Get("/v1/calibration", Guarded([api](const Request&, Response& res) {
                    json j = ToJson(api.service.station()->Calibration());
                    // Added to the SPEC fields: the latest finished calibrations, newest first.
                    // Null when the history cannot be read: the calibration in force is still

@@ -32,113 +32,132 @@ std::optional<std::string> ParcelIdField(const json& value, Response& res) {
     return id;
 }
 
+// The HTTP status of a finished measurement answered whole: 200 for a size or a refusal (a
+// refusal is a measurement, its reason says why), 500 for a failure (a device fault, an aborted
+// run: stored, the body says which), 507 when it could not be stored.
+int StatusOfFinished(const MeasurementResult& r) {
+    if (NotStored(r)) return 507;
+    return r.status == MeasurementStatus::kFailed ? 500 : 200;
+}
+
+// POST /v1/measure[?wait=1] with an optional body {"parcel_id": ...}.
+void PostMeasure(const ApiContext& api, const Request& req, Response& res) {
+    const std::optional<bool> wait = BoolParam(req, "wait");
+    if (!wait) {
+        SetError(res, ErrorCode::kBadRequest, "wait must be 0, 1, true or false");
+        return;
+    }
+    const std::optional<json> body = JsonObjectBody(req, res, false, {"parcel_id"});
+    if (!body) return;
+    std::optional<std::string> parcel_id;
+    if (body->contains("parcel_id")) {
+        parcel_id = ParcelIdField(body->at("parcel_id"), res);
+        if (!parcel_id) return;
+    }
+    Result<std::string> id = api.service.Start(std::move(parcel_id));
+    if (!id) {
+        SetError(res, id.error());
+        return;
+    }
+    res.set_header("Location", "/v1/measurements/" + *id);
+    if (!*wait) {
+        SetJson(res, 202, json{{"id", *id}});
+        return;
+    }
+    Result<MeasurementResult> result =
+        api.service.WaitFor(*id, std::chrono::seconds(api.config.wait_timeout_s));
+    if (result) {
+        if (NotStored(*result)) res.headers.erase("Location");  // there is nothing to fetch there
+        SetJson(res, StatusOfFinished(*result), ToJson(*result));
+    } else if (result.error().code == ErrorCode::kTimeout) {
+        SetJson(res, 202, json{{"id", *id}});  // still running: poll by id
+    } else {
+        SetError(res, result.error());
+    }
+}
+
+// GET /v1/measurements?limit=N[&parcel_id=P].
+void ListMeasurements(const ApiContext& api, const Request& req, Response& res) {
+    int limit = 20;
+    if (req.has_param("limit")) {
+        const std::string v = req.get_param_value("limit");
+        const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), limit);
+        if (ec != std::errc() || end != v.data() + v.size() || limit < 1 || limit > 1000) {
+            SetError(res, ErrorCode::kBadRequest, "limit must be an integer in 1..1000");
+            return;
+        }
+    }
+    std::optional<std::string> parcel_id;
+    if (req.has_param("parcel_id")) {
+        parcel_id = ParcelIdField(json(req.get_param_value("parcel_id")), res);
+        if (!parcel_id) return;
+    }
+    auto list = api.store.List(limit, parcel_id);
+    if (!list) {
+        SetError(res, list.error());
+        return;
+    }
+    SetJson(res, 200, json{{"measurements", *list}});
+}
+
+// GET /v1/measurements/{id} (and "last").
+void GetMeasurement(const ApiContext& api, const Request& req, Response& res) {
+    const std::string id = req.matches[1];
+    auto m = id == "last" ? api.store.Last() : api.store.Get(id);
+    if (m && !*m && id != "last") {
+        // Not in the store: a recent result that could not be stored says so (STORAGE_ERROR)
+        // instead of a bare 404 to a client that polls its id.
+        auto recent = api.service.WaitFor(id, std::chrono::milliseconds(0));
+        if (recent && NotStored(*recent)) {
+            SetJson(res, 507, ToJson(*recent));
+            return;
+        }
+    }
+    if (!m) {
+        SetError(res, m.error());
+    } else if (!*m) {
+        SetError(res, ErrorCode::kNotFound, id == "last" ? "no measurement yet" : "no measurement " + id);
+    } else {
+        SetJson(res, 200, **m);
+    }
+}
+
+// GET /v1/measurements/{id}/cloud.ply.
+void GetCloud(const ApiContext& api, const Request& req, Response& res) {
+    const std::string id = req.matches[1];
+    auto path = api.store.CloudPath(id);
+    if (!path) {
+        SetError(res, path.error());
+        return;
+    }
+    if (!*path) {
+        SetError(res, ErrorCode::kNotFound, "no cloud for measurement " + id);
+        return;
+    }
+    bool ok = false;
+    std::string data = ReadFile(**path, ok);
+    if (!ok || data.empty()) {
+        SetError(res, ErrorCode::kNotFound, "the cloud of " + id + " is gone");
+        return;
+    }
+    res.set_header("Content-Disposition", "attachment; filename=\"" + id + ".ply\"");
+    res.set_content(std::move(data), "application/octet-stream");
+}
+
 }  // namespace
 
-void AddMeasurementRoutes(httplib::Server& server, const ApiContext& api) {
-    server.Post("/v1/measure", Guarded([api](const Request& req, Response& res) {
-                    const std::optional<bool> wait = BoolParam(req, "wait");
-                    if (!wait) {
-                        SetError(res, ErrorCode::kBadRequest, "wait must be 0, 1, true or false");
-                        return;
-                    }
-                    const std::optional<json> body = JsonObjectBody(req, res, false);
-                    if (!body) return;
-                    std::optional<std::string> parcel_id;
-                    if (body->contains("parcel_id")) {
-                        parcel_id = ParcelIdField(body->at("parcel_id"), res);
-                        if (!parcel_id) return;
-                    }
-                    Result<std::string> id = api.service.Start(std::move(parcel_id));
-                    if (!id) {
-                        SetError(res, id.error());
-                        return;
-                    }
-                    res.set_header("Location", "/v1/measurements/" + *id);
-                    if (!*wait) {
-                        SetJson(res, 202, json{{"id", *id}});
-                        return;
-                    }
-                    Result<MeasurementResult> result =
-                        api.service.WaitFor(*id, std::chrono::seconds(api.config.wait_timeout_s));
-                    if (result && NotStored(*result)) {
-                        res.headers.erase("Location");  // there is nothing to fetch there
-                        SetJson(res, 507, ToJson(*result));
-                    } else if (result) {
-                        SetJson(res, 200, ToJson(*result));
-                    } else if (result.error().code == ErrorCode::kTimeout) {
-                        SetJson(res, 202, json{{"id", *id}});  // still running: poll by id
-                    } else {
-                        SetError(res, result.error());
-                    }
+void AddMeasurementRoutes(RouteTable& routes, const ApiContext& api) {
+    routes.Post("/v1/measure", Guarded([api](const Request& req, Response& res) {
+                    PostMeasure(api, req, res);
                 }));
-
-    server.Get(
-        "/v1/measurements", Guarded([api](const Request& req, Response& res) {
-            int limit = 20;
-            if (req.has_param("limit")) {
-                const std::string v = req.get_param_value("limit");
-                const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), limit);
-                if (ec != std::errc() || end != v.data() + v.size() || limit < 1 || limit > 1000) {
-                    SetError(res, ErrorCode::kBadRequest, "limit must be an integer in 1..1000");
-                    return;
-                }
-            }
-            std::optional<std::string> parcel_id;
-            if (req.has_param("parcel_id")) {
-                parcel_id = ParcelIdField(json(req.get_param_value("parcel_id")), res);
-                if (!parcel_id) return;
-            }
-            auto list = api.store.List(limit, parcel_id);
-            if (!list) {
-                SetError(res, list.error());
-                return;
-            }
-            SetJson(res, 200, json{{"measurements", *list}});
-        }));
-
-    server.Get(R"(/v1/measurements/([^/]+))", Guarded([api](const Request& req, Response& res) {
-                   const std::string id = req.matches[1];
-                   auto m = id == "last" ? api.store.Last() : api.store.Get(id);
-                   if (m && !*m && id != "last") {
-                       // Not in the store: a recent result that could not be stored says so
-                       // (STORAGE_ERROR) instead of a bare 404 to a client that polls its id.
-                       auto recent = api.service.WaitFor(id, std::chrono::milliseconds(0));
-                       if (recent && NotStored(*recent)) {
-                           SetJson(res, 507, ToJson(*recent));
-                           return;
-                       }
-                   }
-                   if (!m) {
-                       SetError(res, m.error());
-                   } else if (!*m) {
-                       SetError(res, ErrorCode::kNotFound,
-                                id == "last" ? "no measurement yet" : "no measurement " + id);
-                   } else {
-                       SetJson(res, 200, **m);
-                   }
+    routes.Get("/v1/measurements", Guarded([api](const Request& req, Response& res) {
+                   ListMeasurements(api, req, res);
                }));
-
-    server.Get(R"(/v1/measurements/([^/]+)/cloud\.ply)",
-               Guarded([api](const Request& req, Response& res) {
-                   const std::string id = req.matches[1];
-                   auto path = api.store.CloudPath(id);
-                   if (!path) {
-                       SetError(res, path.error());
-                       return;
-                   }
-                   if (!*path) {
-                       SetError(res, ErrorCode::kNotFound, "no cloud for measurement " + id);
-                       return;
-                   }
-                   bool ok = false;
-                   std::string data = ReadFile(**path, ok);
-                   if (!ok || data.empty()) {
-                       SetError(res, ErrorCode::kNotFound, "the cloud of " + id + " is gone");
-                       return;
-                   }
-                   res.set_header("Content-Disposition", "attachment; filename=\"" + id + ".ply\"");
-                   res.set_content(std::move(data), "application/octet-stream");
+    routes.Get(R"(/v1/measurements/([^/]+))", Guarded([api](const Request& req, Response& res) {
+                   GetMeasurement(api, req, res);
                }));
+    routes.Get(R"(/v1/measurements/([^/]+)/cloud\.ply)",
+               Guarded([api](const Request& req, Response& res) { GetCloud(api, req, res); }));
 }
 
 }  // namespace boxd

@@ -42,13 +42,13 @@ void ServeFile(Response& res, const fs::path& path, const char* type, const char
 
 }  // namespace
 
-void AddPageRoutes(httplib::Server& server, const ApiContext& api) {
+void AddPageRoutes(RouteTable& routes, const ApiContext& api) {
     const fs::path page = WebDir(api.config) / "index.html";
     const fs::path three = api.config.three_js;
-    server.Get("/", Guarded([page](const Request&, Response& res) {
+    routes.Get("/", Guarded([page](const Request&, Response& res) {
                    ServeFile(res, page, "text/html; charset=utf-8", "server.web_dir");
                }));
-    server.Get("/three.min.js", Guarded([three](const Request&, Response& res) {
+    routes.Get("/three.min.js", Guarded([three](const Request&, Response& res) {
                    ServeFile(res, three, "application/javascript", "server.three_js");
                }));
 }

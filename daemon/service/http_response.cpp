@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <exception>
 #include <fstream>
 #include <sstream>
@@ -52,7 +53,8 @@ std::optional<bool> BoolParam(const Request& req, const char* name) {
     return std::nullopt;
 }
 
-std::optional<json> JsonObjectBody(const Request& req, Response& res, bool required) {
+std::optional<json> JsonObjectBody(const Request& req, Response& res, bool required,
+                                   std::initializer_list<const char*> keys) {
     if (req.body.empty()) {
         if (!required) return json::object();
         SetError(res, ErrorCode::kBadRequest, "a JSON object body is required");
@@ -65,6 +67,17 @@ std::optional<json> JsonObjectBody(const Request& req, Response& res, bool requi
     }
     if (!body.is_object()) {
         SetError(res, ErrorCode::kBadRequest, "the body must be a JSON object");
+        return std::nullopt;
+    }
+    for (const auto& [key, value] : body.items()) {
+        if (std::find_if(keys.begin(), keys.end(), [&](const char* k) { return key == k; }) !=
+            keys.end()) {
+            continue;
+        }
+        std::string known;
+        for (const char* k : keys) known += std::string(known.empty() ? "" : ", ") + k;
+        SetError(res, ErrorCode::kBadRequest,
+                 "unknown key \"" + key.substr(0, 64) + "\" in the body (it may have: " + known + ")");
         return std::nullopt;
     }
     return body;

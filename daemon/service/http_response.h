@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -40,8 +41,9 @@ std::string ReadFile(const std::filesystem::path& path, bool& ok);
 std::optional<bool> BoolParam(const httplib::Request& req, const char* name);
 
 // Returns the request's JSON object body ({} when empty and not `required`), or answers 400
-// BAD_REQUEST and returns nullopt.
+// BAD_REQUEST and returns nullopt: a body that is not a JSON object, or one with a key not in
+// `keys` (a misspelt key would otherwise be dropped in silence), named with the keys it may have.
 std::optional<nlohmann::json> JsonObjectBody(const httplib::Request& req, httplib::Response& res,
-                                             bool required);
+                                             bool required, std::initializer_list<const char*> keys);
 
 }  // namespace boxd

@@ -8,11 +8,8 @@
 #include "daemon/service/daemon_config.h"
 #include "daemon/service/measurement_service.h"
 #include "daemon/service/measurement_store.h"
+#include "daemon/service/route_table.h"
 #include "daemon/service/service_metrics.h"
-
-namespace httplib {
-class Server;
-}
 
 namespace boxd {
 
@@ -26,13 +23,13 @@ struct ApiContext {
 };
 
 // GET /v1/health, GET /v1/status, GET /v1/openapi.json, GET /metrics.
-void AddStatusRoutes(httplib::Server& server, const ApiContext& api);
+void AddStatusRoutes(RouteTable& routes, const ApiContext& api);
 // POST /v1/measure, GET /v1/measurements, /v1/measurements/{id} (and "last"),
 // /v1/measurements/{id}/cloud.ply.
-void AddMeasurementRoutes(httplib::Server& server, const ApiContext& api);
+void AddMeasurementRoutes(RouteTable& routes, const ApiContext& api);
 // POST /v1/calibrate, GET /v1/calibration.
-void AddCalibrationRoutes(httplib::Server& server, const ApiContext& api);
+void AddCalibrationRoutes(RouteTable& routes, const ApiContext& api);
 // GET / (the operator page) and GET /three.min.js.
-void AddPageRoutes(httplib::Server& server, const ApiContext& api);
+void AddPageRoutes(RouteTable& routes, const ApiContext& api);
 
 }  // namespace boxd

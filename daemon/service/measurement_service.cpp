@@ -51,6 +51,14 @@ MeasurementService::MeasurementService(MeasurementStore& store, std::shared_ptr<
     } else {
         spdlog::warn("calibration history unavailable: {}", history.error().message);
     }
+    // The last finished measurement survives a restart in the store: /v1/status and the retained
+    // MQTT state name it from the start, as GET /v1/measurements/last answers it.
+    auto last = store_.Last();
+    if (last && *last) {
+        last_id_ = (*last)->value("id", "");
+    } else if (!last) {
+        spdlog::warn("the last measurement cannot be read: {}", last.error().message);
+    }
 }
 
 MeasurementService::~MeasurementService() {

@@ -35,7 +35,7 @@ struct ServiceSnapshot {
     JobProgress progress;        // of the running one
     std::optional<Error> last_error;
     std::string last_error_at;        // UTC timestamp of last_error
-    std::string last_measurement_id;  // the last finished one in this process, or empty
+    std::string last_measurement_id;  // the last finished one (restored from the store), or ""
     int finished = 0;                 // measurements finished since start
 };
 

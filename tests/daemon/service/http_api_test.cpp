@@ -140,7 +140,7 @@ TEST_F(HttpApiTest, BadRequestsGetTheirCodesAndTheDaemonKeepsServing) {
                 "BAD_REQUEST");
     ExpectError(client_->Get("/v1/nope"), 404, "NOT_FOUND");
     ExpectError(client_->Get("/index.html"), 404, "NOT_FOUND");  // only / serves the page
-    ExpectError(client_->Delete("/v1/measurements/last"), 404, "NOT_FOUND");
+    ExpectError(client_->Delete("/v1/measurements/last"), 405, "METHOD_NOT_ALLOWED");
     ExpectError(client_->Post("/v1/calibrate", "{\"reference_m\": [0.4, 0.3]}", "application/json"),
                 400, "BAD_REQUEST");
     ExpectError(
@@ -257,8 +257,9 @@ TEST_F(HttpApiTest, DeviceFailureIsStoredAndShownAsErrorState) {
     station_->fail_open = true;
     auto res = client_->Post("/v1/measure?wait=1", "", "application/json");
     ASSERT_TRUE(res);
-    ASSERT_EQ(res->status, 200);
+    ASSERT_EQ(res->status, 500) << res->body;  // a device failure, stored: the body says which
     EXPECT_EQ(Body(res)["status"], "failed");
+    EXPECT_EQ(res->get_header_value("Location"), "/v1/measurements/" + Body(res)["id"].get<std::string>());
     EXPECT_EQ(Body(res)["reason"]["code"], "TURNTABLE_ERROR");
     const json s = SettledStatus();
     EXPECT_EQ(s["state"], "error");

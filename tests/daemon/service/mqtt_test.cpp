@@ -135,7 +135,7 @@ void WriteSimWithMqtt(const fs::path& path, const YAML::Node& mqtt) {
     std::ofstream(path) << out.c_str() << "\n";
 }
 
-TEST(ServeMqtt, TheDaemonPublishesItsMeasurementAndIsOfflineAfterKill9) {
+TEST(ServeMqtt, TheDaemonPublishesItsMeasurementIsOfflineAfterKill9AndRestoresItsLast) {
     test::TempDir dir;
     test::MqttBroker broker(dir / "broker");
     ASSERT_TRUE(broker.WaitReady());
@@ -181,6 +181,22 @@ TEST(ServeMqtt, TheDaemonPublishesItsMeasurementAndIsOfflineAfterKill9) {
     const auto after = fleet.WaitFor("boxd/station-7/status", before + 1, 10s);
     ASSERT_EQ(after.size(), before + 1);
     EXPECT_EQ(json::parse(after.back().payload)["state"], "offline");
+
+    // Started again on the same data: the retained state names the last measurement at once, as
+    // /v1/status does, though none has finished in this process.
+    test::ServeDaemon again(dir / "sim-mqtt.yaml", dir / "data", dir / "serve2.log");
+    ASSERT_TRUE(again.WaitHealthy()) << test::ReadText(dir / "serve2.log");
+    EXPECT_EQ(again.GetJson("/v1/status")["last_measurement_id"], "m-000001");
+    EXPECT_TRUE(Eventually(
+        [&] {
+            test::MqttSubscriber late(broker.port(), "boxd/station-7/status");
+            if (!late.WaitSubscribed()) return false;
+            const auto retained = late.WaitFor("boxd/station-7/status", 1, 2s);
+            return !retained.empty() &&
+                   json::parse(retained.back().payload)["state"] != "offline" &&
+                   json::parse(retained.back().payload)["last_measurement_id"] == "m-000001";
+        },
+        10s));
 }
 
 TEST(ServeMqtt, BadMqttSectionsNameTheKeyAndExitWith2) {

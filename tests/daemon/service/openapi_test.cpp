@@ -23,11 +23,11 @@ using nlohmann::json;
 
 using Route = std::pair<std::string, std::string>;  // method (lower case), OpenAPI path
 
-// Returns every route registered with server.Get/Post/... in the daemon's sources, its path
+// Returns every route registered with routes.Get/Post/... in the daemon's sources, its path
 // pattern written as the document's template (a ([^/]+) capture is {id}).
 std::set<Route> RegisteredRoutes() {
     static const std::regex call(
-        R"re(server\.(Get|Post|Put|Delete|Patch)\(\s*(?:R"\(((?:[^)]|\)(?!"))*)\)"|"([^"]*)"))re");
+        R"re(routes\.(Get|Post|Put|Delete|Patch)\(\s*(?:R"\(((?:[^)]|\)(?!"))*)\)"|"([^"]*)"))re");
     std::set<Route> routes;
     for (const auto& entry : fs::directory_iterator(fs::path(BOXD_SOURCE_DIR) / "daemon/service")) {
         if (entry.path().extension() != ".cpp") continue;
@@ -112,6 +112,12 @@ TEST_F(OpenApiServed, RealResponsesOfTheMainRoutesValidateAgainstTheirSchemas) {
     station_->refuse_next = true;
     Keep("post", "/v1/measure", client_->Post("/v1/measure?wait=1", "", "application/json"),
          200);
+    station_->fail_next = true;
+    Keep("post", "/v1/measure", client_->Post("/v1/measure?wait=1", "", "application/json"),
+         500);
+    Keep("post", "/v1/measure",
+         client_->Post("/v1/measure", R"({"parcelId": "PKG-7"})", "application/json"), 400);
+    WaitUntilIdle();
     station_->hold = true;
     Keep("post", "/v1/measure", client_->Post("/v1/measure", "", "application/json"), 202);
     Keep("get", "/v1/status", client_->Get("/v1/status"), 200);  // measuring, with progress
