@@ -199,8 +199,8 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
                 const std::vector<int>& idx = assign[k].idx[gi];
                 if (static_cast<int>(idx.size()) < kMinGroupPoints) continue;
                 const int m = static_cast<int>(idx.size());
-                std::vector<double> w = DepthWeights(assign[k].res[gi], assign[k].slope[gi],
-                                                     config.sigma_floor_m);
+                std::vector<double> w =
+                    DepthWeights(assign[k].res[gi], assign[k].slope[gi], config.sigma_floor_m);
                 if (g == kTable) {
                     auto* f = new TableCost{&pts[k], idx, std::move(w), t0};
                     problem->AddResidualBlock(
@@ -239,6 +239,7 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
             return Error{ErrorCode::kNotConverged,
                          "the joint calibration problem did not converge: " + summary.message};
         }
+        if (config.on_round) config.on_round(outer + 1, config.outer_iterations);
     }
     sol.converged = summary.termination_type == ceres::CONVERGENCE;
 

@@ -1,7 +1,7 @@
 #pragma once
 // The joint calibration problem (Ceres): the table frame (axis tilt and centre), the depth offset
-// (and optionally the depth scale), the lens's focal scale, the reference box's place on the table and small per-pose
-// turntable angle corrections, solved together so that
+// (and optionally the depth scale), the lens's focal scale, the reference box's place on the table
+// and small per-pose turntable angle corrections, solved together so that
 //   - the table-top points around the box lie on the table plane z = 0, and
 //   - the box points of every pose, turned back by the pose's angle about the axis, lie on the
 //     faces of a box of the REFERENCE size standing on the table.
@@ -14,6 +14,7 @@
 // Faces are located by whole-face least squares, never by extreme points.
 
 #include <Eigen/Geometry>
+#include <functional>
 #include <vector>
 
 #include "pipeline/camera.h"
@@ -43,6 +44,8 @@ struct JointRefinementConfig {
     bool estimate_depth_scale = false;
     bool estimate_focal_scale = true;
     int threads = 2;
+    // Told after each outer round: (rounds done, outer_iterations). May be empty.
+    std::function<void(int, int)> on_round;
 };
 
 // The unknowns. The table frame is a correction of `base` (camera -> table, fixed): a point's

@@ -182,7 +182,8 @@ Status CalibrationConfig::Validate() const {
 }
 
 Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDimensions& reference,
-                                           const CalibrationConfig& config) {
+                                           const CalibrationConfig& config,
+                                           const CalibrationProgress& progress) {
     if (Status s = config.Validate(); !s) return s.error();
     const BoxDimensions ref = Sorted(reference);
     if (!(ref.width_m > 0.0 && ref.height_m > 0.0) || ref.length_m > 2.0 || ref.height_m > 2.0) {
@@ -196,8 +197,10 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
                          " poses around the turntable, the session has " + std::to_string(n)};
     }
 
+    if (progress) progress("registering", 0, 1);
     auto est = EstimateInitial(session, config.measure);
     if (!est) return est.error();
+    if (progress) progress("registering", 1, 1);
     CalibrationReport report;
     report.recorded = session.calibration;
     report.reference = ref;
@@ -242,6 +245,8 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
     jc.estimate_depth_scale = config.estimate_depth_scale;
     jc.estimate_focal_scale = config.estimate_focal_scale;
     jc.threads = config.measure.threads;
+    if (progress)
+        jc.on_round = [&progress](int done, int total) { progress("refining", done, total); };
     auto sol = RefineJointly(views, session.camera, ref, init, jc);
     if (!sol) return sol.error();
     const double face_rms_limit =
@@ -259,9 +264,9 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
     report.calibration = sol->calibration;
     report.depth_scale_estimated = config.estimate_depth_scale;
     report.focal_scale_estimated = config.estimate_focal_scale;
-    report.uncertainty = {sol->sigma_center_m, sol->sigma_height_m, sol->sigma_axis_deg,
-                          sol->sigma_depth_offset_m, sol->sigma_depth_scale,
-                          sol->sigma_focal_scale};
+    report.uncertainty = {sol->sigma_center_m,    sol->sigma_height_m,
+                          sol->sigma_axis_deg,    sol->sigma_depth_offset_m,
+                          sol->sigma_depth_scale, sol->sigma_focal_scale};
     report.poses_used = n;
     report.table_points = sol->table_points;
     report.face_points = sol->face_points;

@@ -3,6 +3,7 @@
 // centre and the depth offset from a session of a reference box of known size standing anywhere
 // on the table, with the empty table top around it in view.
 
+#include <functional>
 #include <nlohmann/json_fwd.hpp>
 #include <string>
 #include <vector>
@@ -82,10 +83,16 @@ struct CalibrationReport {
     double axis_change_deg = 0.0;
 };
 
+// Told of each step of a calibration as it goes: the step ("registering", "refining") and how
+// many of its parts are done, of how many.
+using CalibrationProgress = std::function<void(const char* step, int done, int total)>;
+
 // Returns the calibration estimated from `session` (a reference box of size `reference`,
-// any order of length and width) or an error with one of the calibration_error codes.
+// any order of length and width) or an error with one of the calibration_error codes;
+// `progress`, when given, is told of each step.
 Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDimensions& reference,
-                                           const CalibrationConfig& config);
+                                           const CalibrationConfig& config,
+                                           const CalibrationProgress& progress = {});
 
 // Returns the report as JSON: {"calibration": {...}, "quality": {...}, "uncertainty": {...}}.
 // The "calibration" member is what a session's or a daemon config's calibration block holds

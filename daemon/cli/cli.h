@@ -2,6 +2,7 @@
 // The boxd command line: one subcommand per file (cli_<name>.cpp), registered by main.cpp.
 
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "pipeline/result.h"
@@ -28,6 +29,14 @@ void AddSynth(CLI::App& app, Runner& run);
 void AddSimTurntable(CLI::App& app, Runner& run);
 void AddDevices(CLI::App& app, Runner& run);
 void AddBenchMeasure(CLI::App& app, Runner& run);
+
+// Returns "boxd 0.1.0 (commit b3d8619a2f4c, Release build)".
+std::string VersionText();
+
+// Returns the error for an unknown command or an unknown long option of the command in `argv`
+// (naming the nearest valid one), or nothing: checked before parsing, so that a slip is named as
+// such rather than as a missing required option.
+std::optional<Error> CheckArguments(const CLI::App& app, int argc, char** argv);
 
 // Prints "boxd: error: CODE: message" as one line on stderr and returns ExitCodeOf(error.code):
 // the one way a subcommand ends on an error.

@@ -4,9 +4,9 @@
 // peak RSS. --repeat-to N makes the session a disagreeing one of N poses for the scaling
 // figure: its poses repeated in turn under N evenly spaced angles, so that the views contradict
 // the table's angles and one another.
+#include <fcntl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
-#include <fcntl.h>
 #include <unistd.h>
 
 #include <CLI/CLI.hpp>
@@ -109,7 +109,8 @@ int RunBench(const BenchOptions& opt) {
         wall.push_back(std::chrono::duration<double, std::milli>(Clock::now() - a).count());
         if (!out) return Fail(out.error());
         status = StatusName(out->result.status);
-        if (out->result.reason) status += " " + std::string(ErrorCodeName(out->result.reason->code));
+        if (out->result.reason)
+            status += " " + std::string(ErrorCodeName(out->result.reason->code));
         poses_used = out->result.quality.poses;
         for (const auto& [name, ms] : out->result.timing_ms) stages[name].push_back(ms);
     }
@@ -119,8 +120,7 @@ int RunBench(const BenchOptions& opt) {
     rusage usage{};
     getrusage(RUSAGE_SELF, &usage);
     std::printf("session: %s (%zu poses%s x %zu frames, %d threads)\n", opt.session.c_str(),
-                session->poses.size(), opt.repeat_to > 0 ? " repeated" : "", frames,
-                opt.threads);
+                session->poses.size(), opt.repeat_to > 0 ? " repeated" : "", frames, opt.threads);
     std::printf("result: %s, %d poses used\n", status.c_str(), poses_used);
     std::printf("start-up (boxd --help, median of 5): %.1f ms\n", startup_ms);
     std::printf("load (PNG decode): %.1f ms\n", load_ms);

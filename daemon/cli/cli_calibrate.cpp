@@ -8,8 +8,9 @@
 
 #include "calibration/station_calibrator.h"
 #include "daemon/cli/cli.h"
-#include "pipeline/session_io.h"
+#include "daemon/cli/cli_progress.h"
 #include "pipeline/json_text.h"
+#include "pipeline/session_io.h"
 
 namespace boxd::cli {
 
@@ -32,7 +33,11 @@ int RunCalibrate(const CalibrateOptions& opt) {
     config.estimate_focal_scale = !opt.hold_focal_scale;
     // A refusal (too few poses, table not visible, wrong reference, box moved, no convergence)
     // is a problem of the input session: its category makes it exit 2 with the code in the line.
-    auto report = CalibrateStation(*session, reference, config);
+    Progress progress("calibrate", std::chrono::milliseconds(0));  // always seconds
+    auto report = CalibrateStation(
+        *session, reference, config,
+        [&progress](const char* step, int done, int total) { progress.Step(step, done, total); });
+    progress.Finish();
     if (!report) return Fail(report.error());
     if (!opt.out.empty()) {
         std::ofstream file(opt.out);

@@ -1,8 +1,7 @@
 // What every subcommand shares: the one error line and exit code, and the logger.
+#include <malloc.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
-
-#include <malloc.h>
 
 #include <cstdio>
 #include <cstdlib>

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "daemon/cli/cli.h"
+#include "daemon/cli/cli_progress.h"
 #include "daemon/service/daemon_config.h"
 #include "drivers/station_config.h"
 #include "pipeline/json_text.h"
@@ -58,10 +59,15 @@ int RunMeasure(const MeasureOptions& opt) {
     const MonotonicMs clock = SteadyClockMs();
     const std::string started_at = UtcTimestampNow();
     const double start_ms = clock();
+    Progress progress("measure");
+    const int poses = static_cast<int>(session->poses.size());
     const PoseFrameSource frames = [&](std::size_t pose) {
+        progress.Step("pose", static_cast<int>(pose), poses);
         return LoadPoseFrames(opt.session, *session, pose);
     };
     auto out = MeasureFromSource(*session, frames, config, method, clock);
+    progress.Step("pose", poses, poses);
+    progress.Finish();
     if (!out) return Fail(out.error());
     MeasurementResult& result = out->result;
     result.id = "offline";

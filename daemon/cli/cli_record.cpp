@@ -10,11 +10,12 @@
 #include <nlohmann/json.hpp>
 
 #include "daemon/cli/cli.h"
+#include "daemon/cli/cli_progress.h"
 #include "drivers/capture_loop.h"
 #include "drivers/driver_registry.h"
 #include "drivers/station_config.h"
-#include "pipeline/session_io.h"
 #include "pipeline/json_text.h"
+#include "pipeline/session_io.h"
 
 namespace boxd::cli {
 
@@ -58,15 +59,17 @@ int RunRecord(const RecordOptions& options) {
     std::signal(SIGTERM, OnRecordStopSignal);
     CaptureCallbacks callbacks;
     callbacks.cancel = &g_cancel;
-    callbacks.on_progress = [](int pose, int poses) {
-        if (pose < poses) spdlog::info("capture: pose {} of {}", pose + 1, poses);
+    Progress progress("record", std::chrono::milliseconds(0));  // a table turning
+    callbacks.on_progress = [&progress](int pose, int poses) {
+        progress.Step("pose", pose, poses);  // `pose` poses are captured
     };
     // A recording keeps the fixed schedule: from 0, forwards.
     CaptureConfig capture = devices->capture;
     capture.sweep = "from_zero";
     capture.order = "sequential";  // a recording keeps the fixed schedule
-    auto session = CaptureSession(*devices->turntable, *devices->camera, capture,
-                                  devices->station, callbacks);
+    auto session =
+        CaptureSession(*devices->turntable, *devices->camera, capture, devices->station, callbacks);
+    progress.Finish();
     devices->camera->Close();
     std::signal(SIGINT, SIG_DFL);
     std::signal(SIGTERM, SIG_DFL);

@@ -1,7 +1,7 @@
 // `boxd serve`: the daemon (SPEC section 6).
-#include <CLI/CLI.hpp>
 #include <malloc.h>
 
+#include <CLI/CLI.hpp>
 #include <memory>
 
 #include "daemon/cli/cli.h"
@@ -39,7 +39,8 @@ int RunServe(const ServeOptions& o) {
 
 void AddServe(CLI::App& app, Runner& run) {
     auto opts = std::make_shared<ServeOptions>();
-    CLI::App* sub = app.add_subcommand("serve", "Run the daemon (REST/JSON API, SPEC section 6)");
+    CLI::App* sub = app.add_subcommand(
+        "serve", "Run the daemon: the REST/JSON API, MQTT and the operator page (docs/daemon.md)");
     sub->add_option("--config", opts->config, "YAML config file (see config/sim.yaml)")->required();
     sub->add_option("--listen", opts->listen, "HOST:PORT to listen on (overrides server.listen)");
     sub->add_option("--data-dir", opts->data_dir,

@@ -105,8 +105,8 @@ void AddSimTurntable(CLI::App& app, Runner& run) {
     auto opts = std::make_shared<SimTurntableOptions>();
     CLI::App* sub = app.add_subcommand(
         "sim-turntable",
-        "Run a simulated Modbus turntable (SPEC section 8 register map; fault injection through "
-        "flags or the special registers 100..108, see docs/station.md)");
+        "Run a simulated Modbus turntable (the register map and fault injection through "
+        "flags or the special registers 100..108: docs/station.md)");
     sub->add_option("--port", opts->port, "Modbus TCP port to listen on (0 picks a free one)");
     sub->add_option("--host", opts->host, "address to listen on")->capture_default_str();
     sub->add_flag("--exit-with-parent", opts->exit_with_parent,

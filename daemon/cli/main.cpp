@@ -10,9 +10,12 @@ int main(int argc, char** argv) {
     using boxd::Error;
     using boxd::ErrorCode;
     SetupLogging();
-    CLI::App app{"boxd: measures parcels on a turntable with a depth camera"};
+    CLI::App app{
+        "boxd: measures parcels on a turntable with a depth camera. The documentation: "
+        "README.md and docs/ (installed in /usr/share/doc/boxd), man boxd."};
     app.name("boxd");
     app.require_subcommand(1, 1);
+    app.set_version_flag("--version", VersionText(), "print the version, commit and build type");
     Runner run;
     AddServe(app, run);
     AddMeasure(app, run);
@@ -22,10 +25,16 @@ int main(int argc, char** argv) {
     AddSimTurntable(app, run);
     AddDevices(app, run);
     AddBenchMeasure(app, run);
+    if (argc < 2) {
+        // A bare `boxd`: how to use it, on stderr with the exit code of bad usage.
+        std::fprintf(stderr, "%s", app.help().c_str());
+        return ExitCodeOf(ErrorCode::kInvalidInput);
+    }
+    if (auto wrong = CheckArguments(app, argc, argv)) return Fail(*wrong);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        if (e.get_exit_code() == 0) return app.exit(e);  // --help
+        if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
         return Fail(Error{ErrorCode::kInvalidInput, std::string(e.what()) + " (see boxd --help)"});
     }
     try {

@@ -171,8 +171,8 @@ Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms
     }
     const auto t_capture = std::chrono::steady_clock::now();
     last_frame_at_ = t_capture;
-    Result<Session> session = CaptureSession(*devices->turntable, *devices->camera, capture,
-                                             devices->station, callbacks);
+    Result<Session> session =
+        CaptureSession(*devices->turntable, *devices->camera, capture, devices->station, callbacks);
     // Up to the last frame: what comes after it (a last measurement so far) is processing.
     capture_ms = std::chrono::duration<double, std::milli>(
                      (preparer ? last_frame_at_ : std::chrono::steady_clock::now()) - t_capture)
@@ -228,8 +228,8 @@ JobOutput DeviceStation::Measure(const JobContext& ctx) {
                                : "every pose of the plan");
     if (!measured) {
         ViewStream& stream = preparer->Finish(*session);
-        Result<MeasureOutput> streamed = MeasureStreamed(*session, stream, config_.measure,
-                                                         config_.method, SteadyClockMs());
+        Result<MeasureOutput> streamed =
+            MeasureStreamed(*session, stream, config_.measure, config_.method, SteadyClockMs());
         if (!streamed) {
             JobOutput failed = FailedOutput(streamed.error().code, streamed.error().message);
             failed.result.timing_ms["capture"] = capture_ms;
@@ -268,10 +268,17 @@ void DeviceStation::Shutdown() {
 
 DeviceHealth DeviceStation::Devices() const {
     std::lock_guard lock(devices_mutex_);
-    const bool ok = open_.load();
+    const bool open = open_.load();
+    // A device is ok while the station is open, and also while the other device's fault has
+    // closed both: it did not fail itself (it was up, and is re-opened with the other).
+    const auto closed_by = [&](ErrorCode other, const std::string& description) {
+        return device_error_ && device_error_->code == other && !description.empty();
+    };
     return DeviceHealth{
-        DeviceState{config_.station.turntable.driver, turntable_description_, ok},
-        DeviceState{config_.station.camera.driver, camera_description_, ok},
+        DeviceState{config_.station.turntable.driver, turntable_description_,
+                    open || closed_by(ErrorCode::kCameraError, turntable_description_)},
+        DeviceState{config_.station.camera.driver, camera_description_,
+                    open || closed_by(ErrorCode::kTurntableError, camera_description_)},
         device_error_,
     };
 }

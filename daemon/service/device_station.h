@@ -84,6 +84,7 @@ private:
     std::string turntable_description_;
     std::string camera_description_;
     std::filesystem::path calibration_source_;  // the file the calibration in force came from
+    nlohmann::json calibration_run_;  // the run that made it (POST /v1/calibrate's), or null
     // When the last pose of the capture in progress was grabbed (the job thread's).
     std::chrono::steady_clock::time_point last_frame_at_;
 };

@@ -2,6 +2,7 @@
 // station's devices, and the calibration in force.
 #include <spdlog/spdlog.h>
 
+#include <ctime>
 #include <fstream>
 
 #include "calibration/station_calibrator.h"
@@ -13,6 +14,20 @@
 namespace boxd {
 
 using nlohmann::json;
+
+namespace {
+
+// Returns the seconds since `utc` ("2026-12-05T05:56:14.123Z", UtcTimestampNow's form), or
+// nullopt when it is not such a timestamp.
+std::optional<long long> SecondsSince(const std::string& utc) {
+    std::tm tm{};
+    const char* end = strptime(utc.c_str(), "%Y-%m-%dT%H:%M:%S", &tm);
+    if (end == nullptr) return std::nullopt;
+    const std::time_t then = timegm(&tm);
+    return static_cast<long long>(std::difftime(std::time(nullptr), then));
+}
+
+}  // namespace
 
 void DeviceStation::LoadStoredCalibration() {
     namespace fs = std::filesystem;
@@ -40,6 +55,7 @@ void DeviceStation::LoadStoredCalibration() {
     }
     config_.station.calibration = *c;
     calibration_source_ = config_.calibration_file;
+    calibration_run_ = j;
     spdlog::info("calibration: using {} (from POST /v1/calibrate)",
                  config_.calibration_file.string());
 }
@@ -73,6 +89,7 @@ Result<CalibrationRun> DeviceStation::Calibrate(const JobContext& ctx,
     std::lock_guard lock(devices_mutex_);
     config_.station.calibration = run.report.calibration;
     calibration_source_ = config_.calibration_file;
+    calibration_run_ = ToJson(run);
     if (devices_) {
         devices_->station.calibration = run.report.calibration;
         devices_->calibrated = true;
@@ -89,12 +106,16 @@ CalibrationInForce DeviceStation::Calibration() const {
     }
     if (!out.calibration) return out;
     out.source = calibration_source_;
-    // The calibration is as old as the file that carries it.
-    std::error_code ec;
-    const auto mtime = std::filesystem::last_write_time(calibration_source_, ec);
-    if (!ec) {
-        const auto age = std::filesystem::file_time_type::clock::now() - mtime;
-        out.age_s = std::chrono::duration_cast<std::chrono::seconds>(age).count();
+    // Its age is known when the run that made it is: a config's calibration section does not say
+    // when it was made, and the file's time is only when the file was last edited.
+    if (calibration_run_.is_object() &&
+        calibration_run_.value("calibrated_at", json()).is_string()) {
+        out.calibrated_at = calibration_run_["calibrated_at"].get<std::string>();
+        out.age_s = SecondsSince(out.calibrated_at);
+        out.run = json::object();
+        for (const char* key : {"reference_m", "quality", "uncertainty"}) {
+            out.run[key] = calibration_run_.value(key, json());
+        }
     }
     return out;
 }

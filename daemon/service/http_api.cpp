@@ -1,8 +1,8 @@
 #include "daemon/service/http_api.h"
 
+#include <grp.h>
 #include <httplib.h>
 #include <spdlog/spdlog.h>
-#include <grp.h>
 #include <sys/socket.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -137,7 +137,8 @@ httplib::Server::HandlerResponse AnswerError(const RouteTable& routes, const Req
         default:
             // Statuses the HTTP library sets itself (a range it cannot serve, a URI too long):
             // the status stays, the code is the category's.
-            SetError(res, res.status, res.status < 500 ? ErrorCode::kBadRequest : ErrorCode::kInternal,
+            SetError(res, res.status,
+                     res.status < 500 ? ErrorCode::kBadRequest : ErrorCode::kInternal,
                      "the request failed with HTTP status " + std::to_string(res.status));
     }
     return httplib::Server::HandlerResponse::Handled;

@@ -116,7 +116,8 @@ void GetMeasurement(const ApiContext& api, const Request& req, Response& res) {
     if (!m) {
         SetError(res, m.error());
     } else if (!*m) {
-        SetError(res, ErrorCode::kNotFound, id == "last" ? "no measurement yet" : "no measurement " + id);
+        SetError(res, ErrorCode::kNotFound,
+                 id == "last" ? "no measurement yet" : "no measurement " + id);
     } else {
         SetJson(res, 200, **m);
     }
@@ -147,9 +148,8 @@ void GetCloud(const ApiContext& api, const Request& req, Response& res) {
 }  // namespace
 
 void AddMeasurementRoutes(RouteTable& routes, const ApiContext& api) {
-    routes.Post("/v1/measure", Guarded([api](const Request& req, Response& res) {
-                    PostMeasure(api, req, res);
-                }));
+    routes.Post("/v1/measure",
+                Guarded([api](const Request& req, Response& res) { PostMeasure(api, req, res); }));
     routes.Get("/v1/measurements", Guarded([api](const Request& req, Response& res) {
                    ListMeasurements(api, req, res);
                }));

@@ -76,8 +76,9 @@ std::optional<json> JsonObjectBody(const Request& req, Response& res, bool requi
         }
         std::string known;
         for (const char* k : keys) known += std::string(known.empty() ? "" : ", ") + k;
-        SetError(res, ErrorCode::kBadRequest,
-                 "unknown key \"" + key.substr(0, 64) + "\" in the body (it may have: " + known + ")");
+        SetError(
+            res, ErrorCode::kBadRequest,
+            "unknown key \"" + key.substr(0, 64) + "\" in the body (it may have: " + known + ")");
         return std::nullopt;
     }
     return body;

@@ -35,6 +35,8 @@ json ToJson(const CalibrationInForce& c) {
     j["calibrated"] = true;
     j["source"] = c.source.string();
     j["age_s"] = age;
+    j["calibrated_at"] = c.calibrated_at.empty() ? json(nullptr) : json(c.calibrated_at);
+    j["run"] = c.run.is_object() ? c.run : json(nullptr);
     return j;
 }
 

@@ -1,9 +1,17 @@
 #include "daemon/service/service_metrics.h"
 
+#include <sys/resource.h>
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
 #include <string_view>
+#include <vector>
 
 #ifndef BOXD_VERSION
 #define BOXD_VERSION "unknown"
@@ -46,6 +54,53 @@ void AppendHistogram(std::string& out, std::string_view name, std::string_view h
     Sample(out, bucket, "le=\"+Inf\"", static_cast<double>(h.count));
     Sample(out, std::string(name) + "_sum", "", h.sum);
     Sample(out, std::string(name) + "_count", "", static_cast<double>(h.count));
+}
+
+// The standard process metrics of Prometheus' client libraries, from /proc/self (proc(5)): CPU
+// time, start time, memory, file descriptors. Nothing is appended when /proc cannot be read.
+void AppendProcessMetrics(std::string& out) {
+    std::ifstream stat_file("/proc/self/stat");
+    std::string stat((std::istreambuf_iterator<char>(stat_file)), {});
+    // The fields after the command name, which may hold spaces and parentheses: from field 3 on.
+    const std::size_t close = stat.rfind(')');
+    if (close == std::string::npos) return;
+    std::istringstream fields(stat.substr(close + 2));
+    std::vector<std::string> f{std::istream_iterator<std::string>(fields), {}};
+    if (f.size() < 22) return;
+    const double ticks = static_cast<double>(sysconf(_SC_CLK_TCK));
+    const double page = static_cast<double>(sysconf(_SC_PAGESIZE));
+    // Fields 14 utime, 15 stime, 22 starttime (ticks since boot), 23 vsize, 24 rss (pages).
+    const double cpu = (std::stod(f[14 - 3]) + std::stod(f[15 - 3])) / ticks;
+    double boot = 0.0;
+    std::ifstream proc_stat("/proc/stat");
+    for (std::string key; proc_stat >> key;) {
+        if (key == "btime") {
+            proc_stat >> boot;
+            break;
+        }
+    }
+    std::size_t open_fds = 0;
+    std::error_code ec;
+    for (auto it = std::filesystem::directory_iterator("/proc/self/fd", ec);
+         !ec && it != std::filesystem::directory_iterator(); it.increment(ec)) {
+        ++open_fds;
+    }
+    rlimit files{};
+    getrlimit(RLIMIT_NOFILE, &files);
+    Header(out, "process_cpu_seconds_total", "counter",
+           "Total user and system CPU time spent in seconds.");
+    Sample(out, "process_cpu_seconds_total", "", cpu);
+    Header(out, "process_start_time_seconds", "gauge",
+           "Start time of the process since unix epoch in seconds.");
+    Sample(out, "process_start_time_seconds", "", boot + std::stod(f[22 - 3]) / ticks);
+    Header(out, "process_virtual_memory_bytes", "gauge", "Virtual memory size in bytes.");
+    Sample(out, "process_virtual_memory_bytes", "", std::stod(f[23 - 3]));
+    Header(out, "process_resident_memory_bytes", "gauge", "Resident memory size in bytes.");
+    Sample(out, "process_resident_memory_bytes", "", std::stod(f[24 - 3]) * page);
+    Header(out, "process_open_fds", "gauge", "Number of open file descriptors.");
+    Sample(out, "process_open_fds", "", static_cast<double>(open_fds));
+    Header(out, "process_max_fds", "gauge", "Maximum number of open file descriptors.");
+    Sample(out, "process_max_fds", "", static_cast<double>(files.rlim_cur));
 }
 
 }  // namespace
@@ -101,8 +156,7 @@ std::string ServiceMetrics::Text(const MetricsContext& context) const {
            "Measurements without dimensions by status and reason code.");
     for (const auto& [key, n] : by_reason_) {
         Sample(out, "boxd_measurement_reasons_total",
-               "status=\"" + key.first + "\",code=\"" + key.second + "\"",
-               static_cast<double>(n));
+               "status=\"" + key.first + "\",code=\"" + key.second + "\"", static_cast<double>(n));
     }
     AppendHistogram(out, "boxd_measurement_cycle_seconds",
                     "A measurement's whole time: capture, processing and storing.", cycle_);
@@ -120,7 +174,7 @@ std::string ServiceMetrics::Text(const MetricsContext& context) const {
     Sample(out, "boxd_calibrated", "", context.calibrated ? 1 : 0);
     if (context.calibration_age_s) {
         Header(out, "boxd_calibration_age_seconds", "gauge",
-               "Age of the calibration in force (its file's modification time).");
+               "Time since the calibration in force was made (absent when that is not known).");
         Sample(out, "boxd_calibration_age_seconds", "",
                static_cast<double>(*context.calibration_age_s));
     }
@@ -138,6 +192,7 @@ std::string ServiceMetrics::Text(const MetricsContext& context) const {
                "Measurements waiting for the broker or its acknowledgement.");
         Sample(out, "boxd_mqtt_queued", "", static_cast<double>(m.queued));
     }
+    AppendProcessMetrics(out);
     return out;
 }
 

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 
@@ -60,7 +61,11 @@ struct DeviceHealth {
 struct CalibrationInForce {
     std::optional<StationCalibration> calibration;  // nullopt: the station is not calibrated
     std::filesystem::path source;                   // the file the calibration came from
-    std::optional<long long> age_s;                 // the age of `source`; nullopt if unknown
+    std::optional<long long> age_s;  // time since it was made; nullopt when that is not known
+    std::string calibrated_at;       // UTC timestamp of its making, or "" (a config's section)
+    // The run that made it (POST /v1/calibrate): reference_m, quality and uncertainty; null for a
+    // calibration that came with the config.
+    nlohmann::json run;
 };
 
 // A finished calibration of the station (POST /v1/calibrate): the calibrator's report, and when

@@ -108,6 +108,10 @@ TEST(CliCalibrate, CalibratesAndTheCalibrationMakesOtherBoxesMeasureRight) {
     const auto r = RunBoxd({"calibrate", "--session", ref.string(), "--reference", "0.32", "0.26",
                             "0.30", "--hold-focal-scale", "--out", file.string()});
     ASSERT_EQ(r.exit_code, 0) << r.err;
+    // Its progress on stderr, a plain line per step (stderr is a pipe here, not a terminal).
+    EXPECT_NE(r.err.find("boxd: calibrate: refining 1 of 4\n"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("boxd: calibrate: refining 4 of 4\n"), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find('\r'), std::string::npos) << r.err;
     const json out = json::parse(r.out);
     const json& cal = out.at("calibration");
     const StationCalibration truth = TrueCalibration();
@@ -252,6 +256,23 @@ TEST(CliCalibrate, RefusesWhenTheTableIsNotVisible) {
         RunBoxd({"calibrate", "--session", s.string(), "--reference", "0.3", "0.25", "0.3"});
     EXPECT_EQ(r.exit_code, 2);
     EXPECT_NE(r.err.find("TABLE_NOT_VISIBLE"), std::string::npos) << r.err;
+}
+
+// On a terminal (a pseudo-terminal from script(1), as a technician's shell has) the progress is
+// one bar redrawn in place, and its line is ended before the command's own output.
+TEST(CliCalibrate, ShowsABarOnATerminal) {
+    test::TempDir dir;
+    const fs::path ref = dir / "reference";
+    ASSERT_EQ(RunBoxd(Synth(ref, {"0.32", "0.26", "0.30"})).exit_code, 0);
+    const std::string command = std::string(BOXD_BINARY) + " calibrate --session " + ref.string() +
+                                " --reference 0.32 0.26 0.30 > " + (dir / "out.json").string();
+    const auto r = test::RunCommand({"/usr/bin/script", "-qec", command, "/dev/null"});
+    ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
+    EXPECT_NE(r.out.find("\r\033[Kcalibrate [######......"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("] refining 4/4"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("boxd: calibrate: refining"), std::string::npos) << r.out;
+    std::ifstream in(dir / "out.json");
+    EXPECT_TRUE(json::parse(in, nullptr, false).contains("calibration"));
 }
 
 TEST(CliCalibrate, RejectsABadReferenceArgument) {

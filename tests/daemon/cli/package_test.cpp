@@ -1,7 +1,9 @@
 // The Debian package, built the way the README says (`cpack -G DEB` in the build folder) and
 // read back with dpkg-deb: its name and version, its dependencies, the files a station needs
-// (binary, unit, conffile, templates, operator page), the maintainer scripts that add the
-// `boxd` user, and a packaged binary that runs. One test: cpack runs once.
+// (binary, unit, conffile, templates, operator page, man page, copyright, changelog), the
+// maintainer scripts that add the `boxd` user and register the unit as debhelper does, a
+// packaged binary that runs, and lintian's verdict: no error, no warning. One test: cpack runs
+// once.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -48,14 +50,20 @@ void CheckContents(const fs::path& deb, const fs::path& root) {
     } expected[] = {
         {"./usr/bin/boxd", "-rwxr-xr-x"},
         {"./usr/lib/systemd/system/boxd.service", "-rw-r--r--"},
-        {"./etc/boxd/boxd.yaml", "-rw-r-----"},  // may hold the bearer token: not world-readable
+        {"./etc/boxd/boxd.yaml", "-rw-r--r--"},  // postinst makes it 0640 (below)
         {"./usr/share/boxd/config/boxd.yaml", "-rw-r--r--"},
         {"./usr/share/boxd/config/sim.yaml", "-rw-r--r--"},
         {"./usr/share/boxd/web/index.html", "-rw-r--r--"},
+        {"./usr/share/boxd/web/page.js", "-rw-r--r--"},
+        {"./usr/share/boxd/web/cloud_view.js", "-rw-r--r--"},
+        {"./usr/share/boxd/web/page.css", "-rw-r--r--"},
         // The README and the documentation it links.
         {"./usr/share/doc/boxd/README.md", "-rw-r--r--"},
         {"./usr/share/doc/boxd/docs/station.md", "-rw-r--r--"},
         {"./usr/share/doc/boxd/docs/findings/README.md", "-rw-r--r--"},
+        {"./usr/share/doc/boxd/copyright", "-rw-r--r--"},
+        {"./usr/share/doc/boxd/changelog.gz", "-rw-r--r--"},
+        {"./usr/share/man/man1/boxd.1.gz", "-rw-r--r--"},
     };
     for (const auto& e : expected) {
         const std::regex line(std::string("(^|\\n)") + e.mode + R"( root/root +\d+ \S+ \S+ )" +
@@ -68,6 +76,16 @@ void CheckContents(const fs::path& deb, const fs::path& root) {
     EXPECT_NE(unit.find("ExecStart=/usr/bin/boxd serve --config /etc/boxd/boxd.yaml"),
               std::string::npos);
     EXPECT_NE(unit.find("User=boxd"), std::string::npos);
+    EXPECT_NE(unit.find("\nDocumentation=man:boxd(1) "), std::string::npos);
+    // The man page holds every subcommand's options.
+    const auto man =
+        test::RunCommand({"sh", "-c", "zcat " + (root / "usr/share/man/man1/boxd.1.gz").string()});
+    EXPECT_NE(man.out.find(".SS \"boxd measure\""), std::string::npos) << man.out;
+    EXPECT_NE(man.out.find("--reference"), std::string::npos);
+    // Stripped: no symbol table, no debug sections.
+    const auto sections = test::RunCommand({"readelf", "-S", (root / "usr/bin/boxd").string()});
+    EXPECT_EQ(sections.out.find(".symtab"), std::string::npos);
+    EXPECT_EQ(sections.out.find(".debug_"), std::string::npos);
     const auto help = test::RunCommand({(root / "usr/bin/boxd").string(), "--help"});
     EXPECT_EQ(help.exit_code, 0) << help.err;
     EXPECT_NE(help.out.find("serve"), std::string::npos);
@@ -79,7 +97,13 @@ void CheckMaintainerScripts(const fs::path& deb, const fs::path& control) {
     const std::string postinst = ReadAll(control / "postinst");
     EXPECT_NE(postinst.find("adduser --system --group"), std::string::npos) << postinst;
     EXPECT_NE(postinst.find("dialout"), std::string::npos);
-    EXPECT_NE(ReadAll(control / "prerm").find("systemctl stop boxd.service"), std::string::npos);
+    // The config may come to hold the bearer token: not world-readable once installed.
+    EXPECT_NE(postinst.find("chmod 0640 /etc/boxd/boxd.yaml"), std::string::npos) << postinst;
+    EXPECT_NE(ReadAll(control / "prerm").find("deb-systemd-invoke stop boxd.service"),
+              std::string::npos);
+    EXPECT_NE(postinst.find("deb-systemd-helper update-state boxd.service"), std::string::npos);
+    EXPECT_NE(ReadAll(control / "postrm").find("deb-systemd-helper purge boxd.service"),
+              std::string::npos);
     EXPECT_EQ(fs::status(control / "postinst").permissions() & fs::perms::all, fs::perms(0755));
     for (const char* script : {"postinst", "prerm", "postrm"}) {
         const auto syntax = test::RunCommand({"sh", "-n", (control / script).string()});
@@ -87,11 +111,26 @@ void CheckMaintainerScripts(const fs::path& deb, const fs::path& control) {
     }
 }
 
+// Lintian, as Debian's archive runs it: every error and warning fails (pedantic and
+// experimental tags are not asked for).
+void CheckLintian(const fs::path& deb) {
+    const auto lintian =
+        test::RunCommand({"lintian", "--fail-on", "error,warning", "--display-info",
+                          "--no-tag-display-limit", deb.string()});
+    EXPECT_EQ(lintian.exit_code, 0) << lintian.out << lintian.err;
+    EXPECT_EQ(lintian.out.find("E: "), std::string::npos) << lintian.out;
+    EXPECT_EQ(lintian.out.find("W: "), std::string::npos) << lintian.out;
+    for (const char* tag : {"hardening-no-bindnow", "hardening-no-fortify-functions",
+                            "systemd-service-file-missing-documentation-key"}) {
+        EXPECT_EQ(lintian.out.find(tag), std::string::npos) << tag << ":\n" << lintian.out;
+    }
+}
+
 TEST(DebianPackage, HoldsWhatAStationNeedsAndAddsItsUser) {
     test::TempDir dir;
     const auto built = test::RunCommand({"cpack", "-G", "DEB", "--config",
-                                         std::string(BOXD_BUILD_DIR) + "/CPackConfig.cmake",
-                                         "-B", dir.path().string()});
+                                         std::string(BOXD_BUILD_DIR) + "/CPackConfig.cmake", "-B",
+                                         dir.path().string()});
     ASSERT_EQ(built.exit_code, 0) << built.out << built.err;
     const fs::path deb = dir / ("boxd_" BOXD_TEST_VERSION "_amd64.deb");
     ASSERT_TRUE(fs::exists(deb)) << built.out;
@@ -106,6 +145,10 @@ TEST(DebianPackage, HoldsWhatAStationNeedsAndAddsItsUser) {
     {
         SCOPED_TRACE("maintainer scripts");
         CheckMaintainerScripts(deb, dir / "control");
+    }
+    {
+        SCOPED_TRACE("lintian");
+        CheckLintian(deb);
     }
 }
 

@@ -113,6 +113,10 @@ TEST(ServeCalibrationHistory, EveryCalibrationIsListedNewestFirstAcrossARestart)
         ASSERT_TRUE(daemon.WaitHealthy()) << ReadText(log);
         const json before = daemon.GetJson("/v1/calibration");
         EXPECT_EQ(before["calibrated"], true) << before.dump();  // sim.yaml has a calibration
+        // ... whose section does not say when it was made: no age is made up.
+        EXPECT_TRUE(before["calibrated_at"].is_null()) << before.dump();
+        EXPECT_TRUE(before["age_s"].is_null()) << before.dump();
+        EXPECT_TRUE(before["run"].is_null()) << before.dump();
         ASSERT_TRUE(before["history"].is_array()) << before.dump();
         EXPECT_TRUE(before["history"].empty()) << before.dump();
 
@@ -131,7 +135,12 @@ TEST(ServeCalibrationHistory, EveryCalibrationIsListedNewestFirstAcrossARestart)
         // The SPEC fields are still there, now the new calibration's.
         EXPECT_EQ(after["calibrated"], true);
         EXPECT_EQ(after["depth_offset_m"], report["calibration"]["depth_offset_m"]);
-        EXPECT_TRUE(after.contains("age_s"));
+        // Its age is the run's: made moments ago, with this reference and these figures.
+        EXPECT_EQ(after["calibrated_at"], report["calibrated_at"]) << after.dump();
+        EXPECT_GE(after["age_s"].get<long long>(), 0);
+        EXPECT_LT(after["age_s"].get<long long>(), 120);
+        EXPECT_EQ(after["run"]["reference_m"], json({0.455, 0.33, 0.46}));
+        EXPECT_EQ(after["run"]["quality"], report["quality"]);
         const json& history = after["history"];
         ASSERT_EQ(history.size(), 2u) << after.dump(2);
         EXPECT_EQ(history[0]["status"], "ok");
@@ -148,7 +157,10 @@ TEST(ServeCalibrationHistory, EveryCalibrationIsListedNewestFirstAcrossARestart)
     }
     Daemon again(data, log);
     ASSERT_TRUE(again.WaitHealthy()) << ReadText(log);
-    const json history = again.GetJson("/v1/calibration")["history"];
+    const json restored = again.GetJson("/v1/calibration");
+    EXPECT_FALSE(restored["calibrated_at"].is_null()) << restored.dump();  // kept across starts
+    EXPECT_GE(restored["age_s"].get<long long>(), 0);
+    const json history = restored["history"];
     ASSERT_EQ(history.size(), 2u) << history.dump();
     EXPECT_EQ(history[0]["status"], "ok");
     EXPECT_EQ(history[1]["error"]["code"], "WRONG_REFERENCE");

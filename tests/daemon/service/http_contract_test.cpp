@@ -38,18 +38,19 @@ TEST_F(HttpApiTest, AFailedMeasurementIs500WithTheStoredResultARefusalIs200) {
 
 TEST_F(HttpApiTest, UnknownBodyKeysAre400NamingTheKeyAndStartNothing) {
     for (const std::string key : {"parcelId", "parcel", "Parcel_ID"}) {
-        auto res = client_->Post("/v1/measure?wait=1", R"({")" + key + R"(": "ABC"})",
-                                 "application/json");
+        auto res =
+            client_->Post("/v1/measure?wait=1", R"({")" + key + R"(": "ABC"})", "application/json");
         ExpectError(res, 400, "BAD_REQUEST");
         EXPECT_NE(res->body.find(key), std::string::npos) << res->body;
         EXPECT_NE(res->body.find("parcel_id"), std::string::npos) << res->body;  // what it may be
     }
-    auto both = client_->Post("/v1/measure", R"({"parcel_id": "A", "wait": 1})",
-                              "application/json");
+    auto both =
+        client_->Post("/v1/measure", R"({"parcel_id": "A", "wait": 1})", "application/json");
     ExpectError(both, 400, "BAD_REQUEST");
     EXPECT_NE(both->body.find("\\\"wait\\\""), std::string::npos) << both->body;
-    auto calibrate = client_->Post(
-        "/v1/calibrate", R"({"reference_m": [0.4, 0.3, 0.2], "referenceM": 1})", "application/json");
+    auto calibrate =
+        client_->Post("/v1/calibrate", R"({"reference_m": [0.4, 0.3, 0.2], "referenceM": 1})",
+                      "application/json");
     ExpectError(calibrate, 400, "BAD_REQUEST");
     EXPECT_NE(calibrate->body.find("referenceM"), std::string::npos) << calibrate->body;
     auto list = client_->Get("/v1/measurements");
@@ -95,6 +96,29 @@ TEST_F(HttpApiTest, TheLastMeasurementIdIsRestoredAfterARestart) {
     const json status = Body(client_->Get("/v1/status"));
     EXPECT_EQ(status["last_measurement_id"], "m-000002") << status.dump();
     EXPECT_EQ(Body(client_->Get("/v1/measurements/last"))["id"], "m-000002");
+}
+
+// The page's files carry an ETag: a browser revalidates them on each load, and one that did not
+// change costs a 304 without a body (three.js alone is 850 KB).
+TEST_F(HttpApiTest, ThePagesFilesAreRevalidatedByETag) {
+    for (const char* path : {"/", "/page.js", "/page.css", "/cloud_view.js", "/three.min.js"}) {
+        auto first = client_->Get(path);
+        ASSERT_TRUE(first);
+        ASSERT_EQ(first->status, 200) << path << ": " << first->body;
+        EXPECT_EQ(first->get_header_value("Cache-Control"), "no-cache") << path;
+        const std::string etag = first->get_header_value("ETag");
+        ASSERT_FALSE(etag.empty()) << path;
+        auto again = client_->Get(path, {{"If-None-Match", etag}});
+        ASSERT_TRUE(again);
+        EXPECT_EQ(again->status, 304) << path;
+        EXPECT_TRUE(again->body.empty()) << path;
+        EXPECT_EQ(again->get_header_value("ETag"), etag) << path;
+        auto stale = client_->Get(path, {{"If-None-Match", "\"0-0\""}});
+        ASSERT_TRUE(stale);
+        EXPECT_EQ(stale->status, 200) << path;
+        EXPECT_EQ(stale->body, first->body) << path;
+    }
+    EXPECT_NE(client_->Get("/")->body.find(R"(<script src="/page.js">)"), std::string::npos);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <chrono>
+#include <ctime>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -181,6 +182,18 @@ TEST(ServeSimStation, MeasuresTheSimulatedBoxAndServesItAcrossKill9) {
         EXPECT_NEAR(samples.at("boxd_measurement_cycle_seconds_sum"),
                     first["timing_ms"]["total"].get<double>() / 1e3, 1e-3);
         EXPECT_EQ(samples.at("boxd_calibrated"), 1);
+        // The config's calibration section does not say when it was made: no age is made up
+        // (the config file's time is not the calibration's).
+        EXPECT_EQ(samples.count("boxd_calibration_age_seconds"), 0u) << metrics->body;
+        // The standard process metrics, as a client library's would be.
+        const double now = static_cast<double>(std::time(nullptr));
+        EXPECT_GT(samples.at("process_resident_memory_bytes"), 10e6);
+        EXPECT_GE(samples.at("process_virtual_memory_bytes"),
+                  samples.at("process_resident_memory_bytes"));
+        EXPECT_GT(samples.at("process_cpu_seconds_total"), 0.0);
+        EXPECT_NEAR(samples.at("process_start_time_seconds"), now - 30.0, 60.0);
+        EXPECT_GT(samples.at("process_open_fds"), 3.0);
+        EXPECT_LT(samples.at("process_open_fds"), samples.at("process_max_fds"));
         const json openapi = daemon.GetJson("/v1/openapi.json");
         for (const char* path : {"/", "/v1/measure", "/v1/measurements/{id}", "/metrics"}) {
             EXPECT_TRUE(openapi["paths"].contains(path)) << path;
