@@ -47,7 +47,7 @@ add_custom_command(OUTPUT ${doc_build}/changelog.gz
 # The man page, from the binary's own help (help2man), with every subcommand's help in it.
 find_program(BOXD_HELP2MAN help2man)
 set(package_files ${doc_build}/changelog.gz)
-if(BOXD_HELP2MAN)
+if(BOXD_HELP2MAN AND NOT BOXD_SANITIZE AND NOT BOXD_TSAN AND NOT BOXD_FUZZ)  # a product build
     add_custom_command(OUTPUT ${doc_build}/boxd.1.gz
         COMMAND ${CMAKE_COMMAND} -DBOXD=$<TARGET_FILE:boxd> -DHELP2MAN=${BOXD_HELP2MAN}
                 -DOUT=${doc_build}/boxd.1 -P ${PROJECT_SOURCE_DIR}/systemd/man_page.cmake
@@ -56,7 +56,7 @@ if(BOXD_HELP2MAN)
     list(APPEND package_files ${doc_build}/boxd.1.gz)
     install(FILES ${doc_build}/boxd.1.gz DESTINATION share/man/man1)
 else()
-    message(STATUS "no help2man: the package will have no man page (apt install help2man)")
+    message(STATUS "no man page in this build (a sanitizer build, or no help2man)")
 endif()
 add_custom_target(boxd_package_files ALL DEPENDS ${package_files})
 install(FILES ${doc_build}/copyright ${doc_build}/changelog.gz DESTINATION share/doc/boxd)

@@ -62,11 +62,11 @@ int RunMeasure(const MeasureOptions& opt) {
     Progress progress("measure");
     const int poses = static_cast<int>(session->poses.size());
     const PoseFrameSource frames = [&](std::size_t pose) {
-        progress.Step("pose", static_cast<int>(pose), poses);
+        progress.Step("prepared", static_cast<int>(pose), poses);
         return LoadPoseFrames(opt.session, *session, pose);
     };
     auto out = MeasureFromSource(*session, frames, config, method, clock);
-    progress.Step("pose", poses, poses);
+    progress.Step("prepared", poses, poses);
     progress.Finish();
     if (!out) return Fail(out.error());
     MeasurementResult& result = out->result;

@@ -61,7 +61,7 @@ int RunRecord(const RecordOptions& options) {
     callbacks.cancel = &g_cancel;
     Progress progress("record", std::chrono::milliseconds(0));  // a table turning
     callbacks.on_progress = [&progress](int pose, int poses) {
-        progress.Step("pose", pose, poses);  // `pose` poses are captured
+        progress.Step("captured", pose, poses);  // `pose` poses are captured
     };
     // A recording keeps the fixed schedule: from 0, forwards.
     CaptureConfig capture = devices->capture;

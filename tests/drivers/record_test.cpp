@@ -82,6 +82,11 @@ TEST(BoxdRecord, SimulatedStationMatchesSynthOfTheSameScene) {
     const auto rec = RunBoxd({"record", "--config", (dir / "station.yaml").string(), "--out",
                               (dir / "recorded").string()});
     ASSERT_EQ(rec.exit_code, 0) << rec.err;
+    // Its progress on stderr, a line per pose (not a terminal here), up to the last.
+    const std::string last = "boxd: record: captured " + std::to_string(kPoses) + " of " +
+                             std::to_string(kPoses) + "\n";
+    EXPECT_NE(rec.err.find("boxd: record: captured 1 of "), std::string::npos) << rec.err;
+    EXPECT_NE(rec.err.find(last), std::string::npos) << rec.err;
     const auto summary = nlohmann::json::parse(rec.out);
     EXPECT_EQ(summary["poses"], kPoses);
     EXPECT_EQ(summary["frames"], kPoses * kFrames);
