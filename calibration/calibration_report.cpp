@@ -4,7 +4,7 @@
 #include <string>
 
 #include "calibration/station_calibrator.h"
-#include "pipeline/station_calibration_json.h"
+#include "pipeline/io/station_calibration_json.h"
 
 namespace boxd {
 

@@ -4,11 +4,11 @@
 #include <ceres/rotation.h>
 #include <spdlog/spdlog.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
 
+#include "calibration/joint_covariance.h"
 #include "calibration/joint_residuals.h"
 
 namespace boxd {
@@ -119,9 +119,153 @@ Assignment Assign(const PosePoints& pts, const Eigen::Vector3d& t0, const JointS
     return out;
 }
 
-double MaxEigen2(const Eigen::Matrix2d& m) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(m);
-    return std::max(0.0, es.eigenvalues().maxCoeff());
+// Each view's pixels as the residual model takes them: their lateral rays and raw depths in the
+// frame of the initial camera-to-table `base`.
+std::vector<PosePoints> ViewPoints(const std::vector<CalibrationView>& views,
+                                   const Eigen::Isometry3d& base) {
+    const Eigen::Matrix3d r0 = base.linear();
+    std::vector<PosePoints> pts(views.size());
+    for (std::size_t k = 0; k < views.size(); ++k) {
+        const CalibrationView& v = views[k];
+        pts[k].a.reserve(v.ray.size());
+        pts[k].axial = r0.col(2);
+        for (std::size_t i = 0; i < v.ray.size(); ++i) {
+            pts[k].a.push_back(r0 * Eigen::Vector3d(v.ray[i].x(), v.ray[i].y(), 0.0));
+            pts[k].raw_z.push_back(v.raw_z_m[i]);
+        }
+    }
+    return pts;
+}
+
+// Assigns every view's points to the table or a face of the model at state `s`, within each
+// (pose, group)'s band, and sets the bands of the next assignment from the residuals' spread.
+std::vector<Assignment> AssignViews(const std::vector<PosePoints>& pts, const Eigen::Vector3d& t0,
+                                    const JointState& s, const BoxDimensions& reference,
+                                    std::vector<std::array<double, kGroups>>& band,
+                                    const JointRefinementConfig& config) {
+    std::vector<Assignment> assign(pts.size());
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+        assign[k] = Assign(pts[k], t0, s, s.angle_rad[k], reference, band[k], config);
+        for (int g = 0; g < kGroups; ++g) {
+            const double sigma = std::max(RobustSigma(assign[k].res[static_cast<std::size_t>(g)]),
+                                          config.sigma_floor_m);
+            band[k][static_cast<std::size_t>(g)] =
+                std::max(config.band_sigmas * sigma, config.min_band_m);
+        }
+    }
+    return assign;
+}
+
+// Returns the least-squares problem of one round over `s`'s blocks: the table points' and the
+// faces' weighted depth residuals of `assign`; counts them in `sol`.
+std::unique_ptr<ceres::Problem> BuildProblem(const std::vector<PosePoints>& pts,
+                                             const std::vector<Assignment>& assign,
+                                             const Eigen::Vector3d& t0,
+                                             const BoxDimensions& reference,
+                                             const JointRefinementConfig& config,
+                                             JointSolution& sol) {
+    JointState& s = sol.state;
+    ceres::Problem::Options popt;
+    popt.cost_function_ownership = ceres::TAKE_OWNERSHIP;
+    auto problem = std::make_unique<ceres::Problem>(popt);
+    problem->AddParameterBlock(s.frame, 5);
+    problem->AddParameterBlock(s.depth, 3);
+    std::vector<int> held;
+    if (!config.estimate_depth_scale) held.push_back(1);
+    if (!config.estimate_focal_scale) held.push_back(2);
+    if (!held.empty()) problem->SetManifold(s.depth, new ceres::SubsetManifold(3, held));
+    problem->AddParameterBlock(s.box, 3);
+    for (double& angle : s.angle_rad) problem->AddParameterBlock(&angle, 1);
+    problem->SetParameterBlockConstant(&s.angle_rad[0]);
+    sol.table_points = 0;
+    sol.face_points = 0;
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+        for (int g = 0; g < kGroups; ++g) {
+            const auto gi = static_cast<std::size_t>(g);
+            const std::vector<int>& idx = assign[k].idx[gi];
+            if (static_cast<int>(idx.size()) < kMinGroupPoints) continue;
+            const int m = static_cast<int>(idx.size());
+            std::vector<double> w =
+                DepthWeights(assign[k].res[gi], assign[k].slope[gi], config.sigma_floor_m);
+            if (g == kTable) {
+                auto* f = new TableCost{&pts[k], idx, std::move(w), t0};
+                problem->AddResidualBlock(
+                    new ceres::AutoDiffCostFunction<TableCost, ceres::DYNAMIC, 5, 3>(f, m), nullptr,
+                    s.frame, s.depth);
+                sol.table_points += m;
+            } else {
+                auto* f = new FaceCost{&pts[k], idx, std::move(w), t0, g, reference};
+                problem->AddResidualBlock(
+                    new ceres::AutoDiffCostFunction<FaceCost, ceres::DYNAMIC, 5, 3, 3, 1>(f, m),
+                    nullptr, s.frame, s.depth, s.box, &s.angle_rad[k]);
+                sol.face_points += m;
+            }
+        }
+    }
+    return problem;
+}
+
+// Solves one round's problem; an error when too few points agree with the model or the solver
+// gives nothing usable.
+Status SolveRound(ceres::Problem& problem, const JointRefinementConfig& config, int round,
+                  JointSolution& sol, ceres::Solver::Summary& summary) {
+    if (sol.table_points < 500 || sol.face_points < 500) {
+        return Error{ErrorCode::kNotConverged,
+                     "too few points on the table (" + std::to_string(sol.table_points) +
+                         ") or on the reference box faces (" + std::to_string(sol.face_points) +
+                         ") agree with the model"};
+    }
+    ceres::Solver::Options opt;
+    opt.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+    opt.max_num_iterations = config.max_solver_iterations;
+    opt.num_threads = config.threads;
+    opt.function_tolerance = 1e-12;
+    opt.parameter_tolerance = 1e-12;
+    opt.gradient_tolerance = 1e-14;
+    ceres::Solve(opt, &problem, &summary);
+    spdlog::debug(
+        "calibrate: round {}: {} table + {} face points, cost {:.4g} -> {:.4g}, offset "
+        "{:.5f} m, focal scale {:.5f}",
+        round, sol.table_points, sol.face_points, summary.initial_cost, summary.final_cost,
+        sol.state.depth[0], sol.state.depth[2]);
+    if (!summary.IsSolutionUsable()) {
+        return Error{ErrorCode::kNotConverged,
+                     "the joint calibration problem did not converge: " + summary.message};
+    }
+    return OkStatus();
+}
+
+// Sets `sol`'s unweighted RMS figures of the table and the faces at its state.
+void RmsFigures(const std::vector<PosePoints>& pts, const Eigen::Vector3d& t0,
+                const BoxDimensions& reference,
+                const std::vector<std::array<double, kGroups>>& band,
+                const JointRefinementConfig& config, JointSolution& sol) {
+    double table_sum = 0.0, face_sum = 0.0;
+    long table_n = 0, face_n = 0;
+    const JointState& s = sol.state;
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+        const Assignment a = Assign(pts[k], t0, s, s.angle_rad[k], reference, band[k], config);
+        for (int g = 0; g < kGroups; ++g) {
+            for (double r : a.res[static_cast<std::size_t>(g)]) {
+                (g == kTable ? table_sum : face_sum) += r * r;
+                ++(g == kTable ? table_n : face_n);
+            }
+        }
+    }
+    sol.table_rms_m = table_n > 0 ? std::sqrt(table_sum / static_cast<double>(table_n)) : 0.0;
+    sol.face_rms_m = face_n > 0 ? std::sqrt(face_sum / static_cast<double>(face_n)) : 0.0;
+}
+
+// Returns the calibration block of state `s`.
+StationCalibration CalibrationOf(const JointState& s) {
+    const Eigen::Isometry3d table_to_cam = JointCameraToTable(s).inverse();
+    StationCalibration c;
+    c.table_center_m = table_to_cam.translation();
+    c.table_axis = table_to_cam.linear().col(2).normalized();
+    c.depth_offset_m = s.depth[0];
+    c.depth_scale = s.depth[1];
+    c.focal_scale = s.depth[2];
+    return c;
 }
 
 }  // namespace
@@ -146,158 +290,29 @@ Result<JointSolution> RefineJointly(const std::vector<CalibrationView>& views,
         return Error{ErrorCode::kInvalidConfig, "joint refinement: one angle per view is needed"};
     }
     (void)camera;
-    const Eigen::Matrix3d r0 = init.base.linear();
     const Eigen::Vector3d t0 = init.base.translation();
-    std::vector<PosePoints> pts(n);
-    for (std::size_t k = 0; k < n; ++k) {
-        const CalibrationView& v = views[k];
-        pts[k].a.reserve(v.ray.size());
-        pts[k].axial = r0.col(2);
-        for (std::size_t i = 0; i < v.ray.size(); ++i) {
-            pts[k].a.push_back(r0 * Eigen::Vector3d(v.ray[i].x(), v.ray[i].y(), 0.0));
-            pts[k].raw_z.push_back(v.raw_z_m[i]);
-        }
-    }
-
+    const std::vector<PosePoints> pts = ViewPoints(views, init.base);
     JointSolution sol;
     sol.state = init;
-    JointState& s = sol.state;
     // Per pose and group: the band of the next assignment.
     std::vector<std::array<double, kGroups>> band(n);
     for (std::size_t k = 0; k < n; ++k) band[k].fill(config.initial_band_m);
 
     ceres::Solver::Summary summary;
     std::unique_ptr<ceres::Problem> problem;
-    for (int outer = 0; outer < config.outer_iterations; ++outer) {
-        std::vector<Assignment> assign(n);
-        for (std::size_t k = 0; k < n; ++k) {
-            assign[k] = Assign(pts[k], t0, s, s.angle_rad[k], reference, band[k], config);
-            for (int g = 0; g < kGroups; ++g) {
-                const double sigma = std::max(
-                    RobustSigma(assign[k].res[static_cast<std::size_t>(g)]), config.sigma_floor_m);
-                band[k][static_cast<std::size_t>(g)] =
-                    std::max(config.band_sigmas * sigma, config.min_band_m);
-            }
+    for (int round = 0; round < config.outer_iterations; ++round) {
+        const std::vector<Assignment> assign =
+            AssignViews(pts, t0, sol.state, reference, band, config);
+        problem = BuildProblem(pts, assign, t0, reference, config, sol);
+        if (Status solved = SolveRound(*problem, config, round, sol, summary); !solved) {
+            return solved.error();
         }
-        ceres::Problem::Options popt;
-        popt.cost_function_ownership = ceres::TAKE_OWNERSHIP;
-        problem = std::make_unique<ceres::Problem>(popt);
-        problem->AddParameterBlock(s.frame, 5);
-        problem->AddParameterBlock(s.depth, 3);
-        std::vector<int> held;
-        if (!config.estimate_depth_scale) held.push_back(1);
-        if (!config.estimate_focal_scale) held.push_back(2);
-        if (!held.empty()) problem->SetManifold(s.depth, new ceres::SubsetManifold(3, held));
-        problem->AddParameterBlock(s.box, 3);
-        for (std::size_t k = 0; k < n; ++k) problem->AddParameterBlock(&s.angle_rad[k], 1);
-        problem->SetParameterBlockConstant(&s.angle_rad[0]);
-        sol.table_points = 0;
-        sol.face_points = 0;
-        for (std::size_t k = 0; k < n; ++k) {
-            for (int g = 0; g < kGroups; ++g) {
-                const auto gi = static_cast<std::size_t>(g);
-                const std::vector<int>& idx = assign[k].idx[gi];
-                if (static_cast<int>(idx.size()) < kMinGroupPoints) continue;
-                const int m = static_cast<int>(idx.size());
-                std::vector<double> w =
-                    DepthWeights(assign[k].res[gi], assign[k].slope[gi], config.sigma_floor_m);
-                if (g == kTable) {
-                    auto* f = new TableCost{&pts[k], idx, std::move(w), t0};
-                    problem->AddResidualBlock(
-                        new ceres::AutoDiffCostFunction<TableCost, ceres::DYNAMIC, 5, 3>(f, m),
-                        nullptr, s.frame, s.depth);
-                    sol.table_points += m;
-                } else {
-                    auto* f = new FaceCost{&pts[k], idx, std::move(w), t0, g, reference};
-                    problem->AddResidualBlock(
-                        new ceres::AutoDiffCostFunction<FaceCost, ceres::DYNAMIC, 5, 3, 3, 1>(f, m),
-                        nullptr, s.frame, s.depth, s.box, &s.angle_rad[k]);
-                    sol.face_points += m;
-                }
-            }
-        }
-        if (sol.table_points < 500 || sol.face_points < 500) {
-            return Error{ErrorCode::kNotConverged,
-                         "too few points on the table (" + std::to_string(sol.table_points) +
-                             ") or on the reference box faces (" + std::to_string(sol.face_points) +
-                             ") agree with the model"};
-        }
-        ceres::Solver::Options opt;
-        opt.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-        opt.max_num_iterations = config.max_solver_iterations;
-        opt.num_threads = config.threads;
-        opt.function_tolerance = 1e-12;
-        opt.parameter_tolerance = 1e-12;
-        opt.gradient_tolerance = 1e-14;
-        ceres::Solve(opt, problem.get(), &summary);
-        spdlog::debug(
-            "calibrate: round {}: {} table + {} face points, cost {:.4g} -> {:.4g}, offset "
-            "{:.5f} m, focal scale {:.5f}",
-            outer, sol.table_points, sol.face_points, summary.initial_cost, summary.final_cost,
-            s.depth[0], s.depth[2]);
-        if (!summary.IsSolutionUsable()) {
-            return Error{ErrorCode::kNotConverged,
-                         "the joint calibration problem did not converge: " + summary.message};
-        }
-        if (config.on_round) config.on_round(outer + 1, config.outer_iterations);
+        if (config.on_round) config.on_round(round + 1, config.outer_iterations);
     }
     sol.converged = summary.termination_type == ceres::CONVERGENCE;
-
-    // Unweighted RMS figures at the solution.
-    {
-        double table_sum = 0.0, face_sum = 0.0;
-        long table_n = 0, face_n = 0;
-        for (std::size_t k = 0; k < n; ++k) {
-            const Assignment a = Assign(pts[k], t0, s, s.angle_rad[k], reference, band[k], config);
-            for (int g = 0; g < kGroups; ++g) {
-                for (double r : a.res[static_cast<std::size_t>(g)]) {
-                    (g == kTable ? table_sum : face_sum) += r * r;
-                    ++(g == kTable ? table_n : face_n);
-                }
-            }
-        }
-        sol.table_rms_m = table_n > 0 ? std::sqrt(table_sum / static_cast<double>(table_n)) : 0.0;
-        sol.face_rms_m = face_n > 0 ? std::sqrt(face_sum / static_cast<double>(face_n)) : 0.0;
-    }
-
-    // Uncertainty: the covariance of the weighted least-squares problem (residuals whitened by
-    // their group's robust sigma), scaled by the reduced chi-square. It is the statistical part
-    // only: systematic errors of the sensor are not in it.
-    ceres::Covariance::Options copt;
-    copt.algorithm_type = ceres::DENSE_SVD;
-    copt.null_space_rank = -1;
-    copt.num_threads = config.threads;
-    ceres::Covariance covariance(copt);
-    std::vector<std::pair<const double*, const double*>> blocks = {{s.frame, s.frame},
-                                                                   {s.depth, s.depth}};
-    const int residuals = problem->NumResiduals();
-    const int params = problem->NumParameters() - (config.estimate_depth_scale ? 0 : 1) -
-                       (config.estimate_focal_scale ? 0 : 1) - 1;
-    const double chi2 = residuals > params ? 2.0 * summary.final_cost / (residuals - params) : 1.0;
-    if (covariance.Compute(blocks, problem.get())) {
-        double cf[25], cd[9];
-        covariance.GetCovarianceBlock(s.frame, s.frame, cf);
-        covariance.GetCovarianceBlock(s.depth, s.depth, cd);
-        const Eigen::Map<const Eigen::Matrix<double, 5, 5, Eigen::RowMajor>> f(cf);
-        sol.sigma_axis_deg = std::sqrt(chi2 * MaxEigen2(f.block<2, 2>(0, 0))) * 180.0 / M_PI;
-        sol.sigma_center_m = std::sqrt(chi2 * MaxEigen2(f.block<2, 2>(2, 2)));
-        sol.sigma_height_m = std::sqrt(chi2 * std::max(0.0, f(4, 4)));
-        sol.sigma_depth_offset_m = std::sqrt(chi2 * std::max(0.0, cd[0]));
-        sol.sigma_depth_scale =
-            config.estimate_depth_scale ? std::sqrt(chi2 * std::max(0.0, cd[4])) : 0.0;
-        sol.sigma_focal_scale =
-            config.estimate_focal_scale ? std::sqrt(chi2 * std::max(0.0, cd[8])) : 0.0;
-    } else {
-        spdlog::warn("calibrate: the covariance of the estimate could not be computed");
-    }
-
-    const Eigen::Isometry3d cam_to_table = JointCameraToTable(s);
-    const Eigen::Isometry3d table_to_cam = cam_to_table.inverse();
-    sol.calibration.table_center_m = table_to_cam.translation();
-    sol.calibration.table_axis = table_to_cam.linear().col(2).normalized();
-    sol.calibration.depth_offset_m = s.depth[0];
-    sol.calibration.depth_scale = s.depth[1];
-    sol.calibration.focal_scale = s.depth[2];
+    RmsFigures(pts, t0, reference, band, config, sol);
+    EstimateUncertainty(*problem, summary.final_cost, config, sol);
+    sol.calibration = CalibrationOf(sol.state);
     return sol;
 }
 

@@ -17,10 +17,10 @@
 #include <functional>
 #include <vector>
 
-#include "pipeline/camera.h"
-#include "pipeline/result.h"
-#include "pipeline/session.h"
-#include "pipeline/station_calibration.h"
+#include "pipeline/core/camera.h"
+#include "pipeline/core/result.h"
+#include "pipeline/core/station_calibration.h"
+#include "pipeline/io/session.h"
 
 namespace boxd {
 

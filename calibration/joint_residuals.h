@@ -10,7 +10,7 @@
 #include <cmath>
 #include <vector>
 
-#include "pipeline/session.h"
+#include "pipeline/io/session.h"
 
 namespace boxd::joint {
 

@@ -8,12 +8,12 @@
 
 #include "calibration/joint_refinement.h"
 #include "calibration/turntable_centre.h"
-#include "pipeline/fuse_and_fit.h"
-#include "pipeline/object_views.h"
-#include "pipeline/prepare_pose.h"
+#include "pipeline/fit/fuse_and_fit.h"
+#include "pipeline/frames/prepare_pose.h"
 #include "pipeline/refusal.h"
-#include "pipeline/register_views.h"
-#include "pipeline/table_plane.h"
+#include "pipeline/registration/register_views.h"
+#include "pipeline/views/object_views.h"
+#include "pipeline/views/table_plane.h"
 
 namespace boxd {
 
@@ -66,7 +66,7 @@ constexpr double kUnknownCenterSigmaM = 1.0;
 // rotate about.
 Result<InitialEstimate> EstimateInitial(const Session& session, const MeasureConfig& mc) {
     InitialEstimate est;
-    auto depths = UsableDepths(PrepareSession(session, mc), mc.refusal);
+    auto depths = UsableDepths(PrepareSession(session, mc.Frames()), mc.refusal);
     if (!depths) return Error{ErrorCode::kTableNotVisible, depths.error().message};
     est.depths = std::move(*depths);
     auto table = FitTablePlane(est.depths, session.camera, session.calibration, mc.table_plane);
@@ -151,6 +151,88 @@ double AngleDeg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
     return std::atan2(a.cross(b).norm(), a.dot(b)) * 180.0 / M_PI;
 }
 
+// Returns WRONG_REFERENCE when the box measured with the recorded calibration (`est`) is not the
+// stated reference `ref` (a wrong box on the table, or a wrong size typed), else Ok.
+Status CheckReference(const InitialEstimate& est, const BoxDimensions& ref,
+                      const CalibrationConfig& config) {
+    const double mismatch = std::max({std::abs(est.box.length_m / ref.length_m - 1.0),
+                                      std::abs(est.box.width_m / ref.width_m - 1.0),
+                                      std::abs(est.box.height_m / ref.height_m - 1.0)});
+    spdlog::info(
+        "calibrate: reference measures {:.4f} x {:.4f} x {:.4f} m with the recorded "
+        "calibration (stated {:.4f} x {:.4f} x {:.4f} m)",
+        est.box.length_m, est.box.width_m, est.box.height_m, ref.length_m, ref.width_m,
+        ref.height_m);
+    if (mismatch <= config.max_reference_mismatch) return OkStatus();
+    return Error{ErrorCode::kWrongReference,
+                 fmt::format("the box on the table measures {:.3f} x {:.3f} x {:.3f} m, not "
+                             "the stated reference {:.3f} x {:.3f} x {:.3f} m ({:.0f}% off): "
+                             "wrong reference box?",
+                             est.box.length_m, est.box.width_m, est.box.height_m, ref.length_m,
+                             ref.width_m, ref.height_m, 100.0 * mismatch)};
+}
+
+// Returns the joint refinement's starting state: the initial estimate's table frame and box,
+// the recorded depth terms, the registered turntable angles.
+JointState InitialState(const InitialEstimate& est, const Session& session) {
+    JointState init;
+    init.base = est.camera_to_table;
+    init.depth[0] = session.calibration.depth_offset_m;
+    init.depth[1] = session.calibration.depth_scale;
+    init.depth[2] = session.calibration.focal_scale;
+    init.box[0] = est.box.center_m.x();
+    init.box[1] = est.box.center_m.y();
+    init.box[2] = std::atan2(est.box.length_axis.y(), est.box.length_axis.x());
+    for (const Se2& p : est.poses) init.angle_rad.push_back(-p.yaw);
+    return init;
+}
+
+// Returns the joint refinement's settings from the calibration's.
+JointRefinementConfig JointConfigOf(const CalibrationConfig& config,
+                                    const CalibrationProgress& progress) {
+    JointRefinementConfig jc;
+    jc.table_ring_inner_m = config.table_ring_inner_m;
+    jc.table_ring_outer_m = config.table_ring_outer_m;
+    jc.face_edge_margin_m = config.face_edge_margin_m;
+    jc.initial_band_m = config.face_band_m;
+    jc.band_sigmas = config.band_sigmas;
+    jc.outer_iterations = config.outer_iterations;
+    jc.max_solver_iterations = config.max_solver_iterations;
+    jc.estimate_depth_scale = config.estimate_depth_scale;
+    jc.estimate_focal_scale = config.estimate_focal_scale;
+    jc.threads = config.measure.threads;
+    if (progress) {
+        jc.on_round = [progress](int done, int total) { progress("refining", done, total); };
+    }
+    return jc;
+}
+
+// Fills `report` with the solution: the calibration, its uncertainty and quality figures, each
+// pose's angle correction, and how far the calibration moved from the recorded one.
+void FillReport(const JointSolution& sol, const Session& session, const CalibrationConfig& config,
+                CalibrationReport& report) {
+    report.calibration = sol.calibration;
+    report.depth_scale_estimated = config.estimate_depth_scale;
+    report.focal_scale_estimated = config.estimate_focal_scale;
+    report.uncertainty = {sol.sigma_center_m,       sol.sigma_height_m,    sol.sigma_axis_deg,
+                          sol.sigma_depth_offset_m, sol.sigma_depth_scale, sol.sigma_focal_scale};
+    const int n = static_cast<int>(session.poses.size());
+    report.poses_used = n;
+    report.table_points = sol.table_points;
+    report.face_points = sol.face_points;
+    report.table_rms_m = sol.table_rms_m;
+    report.face_rms_m = sol.face_rms_m;
+    for (int k = 0; k < n; ++k) {
+        const double commanded = session.PoseAngleRad(static_cast<std::size_t>(k));
+        report.pose_angle_corrections_deg.push_back(
+            Se2::WrapAngle(sol.state.angle_rad[static_cast<std::size_t>(k)] - commanded) * 180.0 /
+            M_PI);
+    }
+    report.center_shift_m =
+        (report.calibration.table_center_m - report.recorded.table_center_m).norm();
+    report.axis_change_deg = AngleDeg(report.calibration.table_axis, report.recorded.table_axis);
+}
+
 }  // namespace
 
 Status CalibrationConfig::Validate() const {
@@ -201,53 +283,16 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
     auto est = EstimateInitial(session, config.measure);
     if (!est) return est.error();
     if (progress) progress("registering", 1, 1);
+    if (Status s = CheckReference(*est, ref, config); !s) return s.error();
     CalibrationReport report;
     report.recorded = session.calibration;
     report.reference = ref;
     report.measured_before = {est->box.length_m, est->box.width_m, est->box.height_m};
-    const double mismatch = std::max({std::abs(est->box.length_m / ref.length_m - 1.0),
-                                      std::abs(est->box.width_m / ref.width_m - 1.0),
-                                      std::abs(est->box.height_m / ref.height_m - 1.0)});
-    spdlog::info(
-        "calibrate: reference measures {:.4f} x {:.4f} x {:.4f} m with the recorded "
-        "calibration (stated {:.4f} x {:.4f} x {:.4f} m)",
-        est->box.length_m, est->box.width_m, est->box.height_m, ref.length_m, ref.width_m,
-        ref.height_m);
-    if (mismatch > config.max_reference_mismatch) {
-        return Error{ErrorCode::kWrongReference,
-                     fmt::format("the box on the table measures {:.3f} x {:.3f} x {:.3f} m, not "
-                                 "the stated reference {:.3f} x {:.3f} x {:.3f} m ({:.0f}% off): "
-                                 "wrong reference box?",
-                                 est->box.length_m, est->box.width_m, est->box.height_m,
-                                 ref.length_m, ref.width_m, ref.height_m, 100.0 * mismatch)};
-    }
 
-    JointState init;
-    init.base = est->camera_to_table;
-    init.depth[0] = session.calibration.depth_offset_m;
-    init.depth[1] = session.calibration.depth_scale;
-    init.depth[2] = session.calibration.focal_scale;
-    init.box[0] = est->box.center_m.x();
-    init.box[1] = est->box.center_m.y();
-    init.box[2] = std::atan2(est->box.length_axis.y(), est->box.length_axis.x());
-    for (const Se2& p : est->poses) init.angle_rad.push_back(-p.yaw);
     const std::vector<CalibrationView> views =
         CollectViews(est->depths, session, *est, ref, config);
-
-    JointRefinementConfig jc;
-    jc.table_ring_inner_m = config.table_ring_inner_m;
-    jc.table_ring_outer_m = config.table_ring_outer_m;
-    jc.face_edge_margin_m = config.face_edge_margin_m;
-    jc.initial_band_m = config.face_band_m;
-    jc.band_sigmas = config.band_sigmas;
-    jc.outer_iterations = config.outer_iterations;
-    jc.max_solver_iterations = config.max_solver_iterations;
-    jc.estimate_depth_scale = config.estimate_depth_scale;
-    jc.estimate_focal_scale = config.estimate_focal_scale;
-    jc.threads = config.measure.threads;
-    if (progress)
-        jc.on_round = [&progress](int done, int total) { progress("refining", done, total); };
-    auto sol = RefineJointly(views, session.camera, ref, init, jc);
+    auto sol = RefineJointly(views, session.camera, ref, InitialState(*est, session),
+                             JointConfigOf(config, progress));
     if (!sol) return sol.error();
     const double face_rms_limit =
         std::max(config.face_rms_ratio * sol->table_rms_m, config.face_rms_floor_m);
@@ -260,27 +305,7 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
                         "and did not move",
                         sol->face_rms_m * 1e3, face_rms_limit * 1e3, sol->table_rms_m * 1e3)};
     }
-
-    report.calibration = sol->calibration;
-    report.depth_scale_estimated = config.estimate_depth_scale;
-    report.focal_scale_estimated = config.estimate_focal_scale;
-    report.uncertainty = {sol->sigma_center_m,    sol->sigma_height_m,
-                          sol->sigma_axis_deg,    sol->sigma_depth_offset_m,
-                          sol->sigma_depth_scale, sol->sigma_focal_scale};
-    report.poses_used = n;
-    report.table_points = sol->table_points;
-    report.face_points = sol->face_points;
-    report.table_rms_m = sol->table_rms_m;
-    report.face_rms_m = sol->face_rms_m;
-    for (int k = 0; k < n; ++k) {
-        const double commanded = session.PoseAngleRad(static_cast<std::size_t>(k));
-        report.pose_angle_corrections_deg.push_back(
-            Se2::WrapAngle(sol->state.angle_rad[static_cast<std::size_t>(k)] - commanded) * 180.0 /
-            M_PI);
-    }
-    report.center_shift_m =
-        (report.calibration.table_center_m - report.recorded.table_center_m).norm();
-    report.axis_change_deg = AngleDeg(report.calibration.table_axis, report.recorded.table_axis);
+    FillReport(*sol, session, config, report);
     if (Status s = report.calibration.Validate(); !s) {
         return Error{ErrorCode::kNotConverged,
                      "the estimate is not a valid calibration: " + s.error().message};

@@ -8,10 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/core/result.h"
+#include "pipeline/core/station_calibration.h"
+#include "pipeline/io/session.h"
 #include "pipeline/measure_config.h"
-#include "pipeline/result.h"
-#include "pipeline/session.h"
-#include "pipeline/station_calibration.h"
 
 namespace boxd {
 
@@ -96,7 +96,7 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
 
 // Returns the report as JSON: {"calibration": {...}, "quality": {...}, "uncertainty": {...}}.
 // The "calibration" member is what a session's or a daemon config's calibration block holds
-// (pipeline/station_calibration_json.h).
+// (pipeline/io/station_calibration_json.h).
 nlohmann::json ToJson(const CalibrationReport& report);
 
 // Returns the calibration file `boxd calibrate --out` writes: YAML with one `calibration:`

@@ -5,8 +5,8 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "pipeline/result.h"
-#include "pipeline/se2.h"
+#include "pipeline/core/result.h"
+#include "pipeline/core/se2.h"
 
 namespace boxd {
 

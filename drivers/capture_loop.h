@@ -9,8 +9,8 @@
 
 #include "drivers/depth_camera.h"
 #include "drivers/turntable.h"
-#include "pipeline/result.h"
-#include "pipeline/session.h"
+#include "pipeline/core/result.h"
+#include "pipeline/io/session.h"
 
 namespace boxd {
 

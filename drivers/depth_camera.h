@@ -10,9 +10,9 @@
 #include <chrono>
 #include <string>
 
-#include "pipeline/camera.h"
-#include "pipeline/depth_image.h"
-#include "pipeline/result.h"
+#include "pipeline/core/camera.h"
+#include "pipeline/core/depth_image.h"
+#include "pipeline/core/result.h"
 
 namespace boxd {
 

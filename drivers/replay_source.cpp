@@ -4,7 +4,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "pipeline/session_io.h"
+#include "pipeline/io/session_io.h"
 
 namespace boxd {
 

@@ -9,8 +9,8 @@
 #include <optional>
 #include <string>
 
-#include "pipeline/result.h"
-#include "pipeline/session.h"
+#include "pipeline/core/result.h"
+#include "pipeline/io/session.h"
 
 namespace boxd {
 

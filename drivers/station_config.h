@@ -13,7 +13,7 @@
 #include "drivers/replay_source.h"
 #include "drivers/sim/simulated_camera.h"
 #include "drivers/turntable.h"
-#include "pipeline/station_calibration.h"
+#include "pipeline/core/station_calibration.h"
 
 namespace YAML {
 class Node;

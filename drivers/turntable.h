@@ -22,7 +22,7 @@
 #include <string>
 
 #include "drivers/turntable_profile.h"
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 namespace YAML {
 class Node;

@@ -8,7 +8,7 @@
 #include <map>
 #include <string>
 
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 namespace boxd {
 

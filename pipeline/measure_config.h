@@ -2,16 +2,17 @@
 // MeasureConfig: the measurement's settings, one struct per stage in recipe order (the YAML
 // sections carry the same names), plus the refusal rules and the confidence figure.
 
-#include "pipeline/box_fit.h"
-#include "pipeline/enclosing_cuboid.h"
-#include "pipeline/frame_averaging.h"
-#include "pipeline/fusion.h"
-#include "pipeline/pose_graph.h"
+#include "pipeline/core/result.h"
+#include "pipeline/envelope/enclosing_cuboid.h"
+#include "pipeline/fit/box_fit.h"
+#include "pipeline/fit/fusion.h"
+#include "pipeline/frames/frame_averaging.h"
+#include "pipeline/frames/prepare_pose.h"
 #include "pipeline/refusal.h"
-#include "pipeline/result.h"
-#include "pipeline/table_plane.h"
-#include "pipeline/view_registration.h"
-#include "pipeline/view_segmentation.h"
+#include "pipeline/registration/pose_graph.h"
+#include "pipeline/registration/view_registration.h"
+#include "pipeline/views/table_plane.h"
+#include "pipeline/views/view_segmentation.h"
 
 namespace boxd {
 
@@ -43,6 +44,8 @@ struct MeasureConfig {
 
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;
+    // Returns what the first stage (PreparePose) takes of it.
+    FrameConfig Frames() const { return FrameConfig{averaging, flying_pixels, threads}; }
 };
 
 enum class BoxMethod { kFootprint, kPca };

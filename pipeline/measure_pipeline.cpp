@@ -6,17 +6,17 @@
 #include <array>
 #include <cmath>
 
-#include "pipeline/enclosing_cuboid.h"
-#include "pipeline/face_choice.h"
-#include "pipeline/fuse_and_fit.h"
-#include "pipeline/object_views.h"
+#include "pipeline/core/student_t.h"
+#include "pipeline/envelope/enclosing_cuboid.h"
+#include "pipeline/envelope/registration_uncertainty.h"
+#include "pipeline/envelope/top_rounding.h"
+#include "pipeline/fit/face_choice.h"
+#include "pipeline/fit/fuse_and_fit.h"
 #include "pipeline/refusal.h"
-#include "pipeline/register_views.h"
-#include "pipeline/registration_uncertainty.h"
-#include "pipeline/student_t.h"
-#include "pipeline/table_plane.h"
-#include "pipeline/top_rounding.h"
+#include "pipeline/registration/register_views.h"
 #include "pipeline/view_stream.h"
+#include "pipeline/views/object_views.h"
+#include "pipeline/views/table_plane.h"
 
 namespace boxd {
 
@@ -257,7 +257,9 @@ Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig
                                      BoxMethod method, const MonotonicMs& clock) {
     return MeasureAfter(
         session,
-        [&]() -> Result<std::vector<PreparedPose>> { return PrepareSession(session, config); },
+        [&]() -> Result<std::vector<PreparedPose>> {
+            return PrepareSession(session, config.Frames());
+        },
         config, method, clock);
 }
 
@@ -265,7 +267,8 @@ Result<MeasureOutput> MeasureFromSource(const Session& header, const PoseFrameSo
                                         const MeasureConfig& config, BoxMethod method,
                                         const MonotonicMs& clock) {
     return MeasureAfter(
-        header, [&] { return PrepareFromSource(header, config, frames); }, config, method, clock);
+        header, [&] { return PrepareFromSource(header, config.Frames(), frames); }, config, method,
+        clock);
 }
 
 }  // namespace boxd

@@ -1,25 +1,26 @@
 #pragma once
 // The measurement recipe: a recorded session in, box dimensions (or the reason why not) out.
-// Its stages, each one call (SPEC section 1):
-//   1. frame averaging and flying-pixel removal per pose    prepare_pose.h
-//   2. the table frame refitted to the table top            table_plane.h
-//   3. each view's object points and registration clouds    object_views.h
-//   4. registration: ICP between views, the pose graph      register_views.h
-// (2 to the ICP of 4 pose by pose, as a capture delivers them: view_stream.h)
-//   5. fusion, 6. the box fits and view consistency        fuse_and_fit.h
+// Its stages, each one call and a folder of its own (SPEC section 1):
+//   frames/        frame averaging and flying-pixel removal per pose     prepare_pose.h
+//   views/         the table frame refitted to the table top             table_plane.h
+//                  each view's object points and registration clouds     object_views.h
+//   registration/  ICP between views, the pose graph                     register_views.h
+// (views and the ICP of registration pose by pose, as a capture delivers them: view_stream.h)
+//   fit/           fusion, the box fits and view consistency             fuse_and_fit.h
+//   envelope/      the smallest enclosing cuboid, its shape and bounds   enclosing_cuboid.h
 // with the refusal rules of refusal.h between them and the settings of measure_config.h.
 // Ids, timestamps, the capture and the total processing time are the caller's: the recipe
 // reports only its stages' laps, on the clock it is given.
 
 #include <vector>
 
+#include "pipeline/core/point_cloud.h"
+#include "pipeline/core/result.h"
+#include "pipeline/core/stage_laps.h"
+#include "pipeline/frames/prepare_pose.h"
+#include "pipeline/io/measurement.h"
+#include "pipeline/io/session.h"
 #include "pipeline/measure_config.h"
-#include "pipeline/measurement.h"
-#include "pipeline/point_cloud.h"
-#include "pipeline/prepare_pose.h"
-#include "pipeline/result.h"
-#include "pipeline/session.h"
-#include "pipeline/stage_laps.h"
 #include "pipeline/view_stream.h"
 
 namespace boxd {

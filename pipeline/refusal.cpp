@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "pipeline/median.h"
+#include "pipeline/core/median.h"
 
 namespace boxd {
 
@@ -247,6 +247,31 @@ void ExplainMultipath(MeasurementReason& why, double multipath_m) {
         "; the time-of-flight camera's multipath correction alone is {:.1f} mm (its light "
         "reaching the parcel by way of the table: a matte dark table top lowers it)",
         multipath_m * 1000.0);
+}
+
+Result<DepthMap> UsableDepth(PreparedPose pose, std::size_t index, const RefusalConfig& refuse) {
+    if (!pose.error.empty()) {
+        return Error{ErrorCode::kInsufficientData, fmt::format("pose {}: {}", index, pose.error)};
+    }
+    const double valid = ValidFraction(pose.depth);
+    if (valid < refuse.min_pose_valid_fraction) {
+        return Error{ErrorCode::kInsufficientData,
+                     fmt::format("pose {} has valid depth readings in only {:.1f}% of its pixels",
+                                 index, 100.0 * valid)};
+    }
+    return std::move(pose.depth);
+}
+
+Result<std::vector<DepthMap>> UsableDepths(std::vector<PreparedPose> poses,
+                                           const RefusalConfig& refuse) {
+    if (poses.empty()) return Error{ErrorCode::kInsufficientData, "the session has no poses"};
+    std::vector<DepthMap> depths(poses.size());
+    for (std::size_t i = 0; i < poses.size(); ++i) {
+        auto depth = UsableDepth(std::move(poses[i]), i, refuse);
+        if (!depth) return depth.error();
+        depths[i] = std::move(*depth);
+    }
+    return depths;
 }
 
 }  // namespace boxd

@@ -6,12 +6,13 @@
 #include <array>
 #include <optional>
 
-#include "pipeline/enclosing_cuboid.h"
-#include "pipeline/fuse_and_fit.h"
-#include "pipeline/measurement.h"
-#include "pipeline/object_views.h"
-#include "pipeline/register_views.h"
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
+#include "pipeline/envelope/enclosing_cuboid.h"
+#include "pipeline/fit/fuse_and_fit.h"
+#include "pipeline/frames/prepare_pose.h"
+#include "pipeline/io/measurement.h"
+#include "pipeline/registration/register_views.h"
+#include "pipeline/views/object_views.h"
 
 namespace boxd {
 
@@ -78,5 +79,15 @@ std::optional<MeasurementReason> CheckEnclosingCuboid(const FusedFit& fit,
 // Adds to an UNCERTAIN refusal the share of a time-of-flight camera's multipath correction
 // (`multipath_m`, the bound's own term; multipath_correction.h) and what lowers it.
 void ExplainMultipath(MeasurementReason& why, double multipath_m);
+
+// Returns pose `index`'s depth map, or INSUFFICIENT_DATA naming it when it cannot be used (its
+// frames could not be averaged, or too few of its pixels have a reading).
+Result<DepthMap> UsableDepth(PreparedPose pose, std::size_t index, const RefusalConfig& refuse);
+
+// Returns the prepared poses' depth maps in pose order, or INSUFFICIENT_DATA naming the pose
+// that cannot be used (its frames could not be averaged, or too few of its pixels have a
+// reading).
+Result<std::vector<DepthMap>> UsableDepths(std::vector<PreparedPose> poses,
+                                           const RefusalConfig& refuse);
 
 }  // namespace boxd

@@ -7,7 +7,7 @@
 #include <cmath>
 #include <memory>
 
-#include "pipeline/parallel_for.h"
+#include "pipeline/core/parallel_for.h"
 
 namespace boxd {
 

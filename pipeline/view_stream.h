@@ -1,10 +1,10 @@
 #pragma once
-// Stages 2 to 4a pose by pose, as a capture delivers them: the table frame from the first pose,
-// then each view's object points and registration clouds, and its ICP alignments with the views
-// before it (its neighbours, and at the end of the turn the loop closures with the first ones).
-// A capture runs them while the table turns, so that after its last pose only that pose's own
-// share, the pose graph, fusion and the fits remain. MeasurePrepared feeds a whole session at
-// once (views and alignments in parallel); either way the views and edges are the same.
+// The views stage and the ICP of registration pose by pose, as a capture delivers them: the table
+// frame from the first pose, then each view's object points and registration clouds, and its ICP
+// alignments with the views before it (its neighbours, and at the end of the turn the loop closures
+// with the first ones). A capture runs them while the table turns, so that after its last pose only
+// that pose's own share, the pose graph, fusion and the fits remain. MeasurePrepared feeds a whole
+// session at once (views and alignments in parallel); either way the views and edges are the same.
 //
 // The views are cut in the table frame of the first pose's table top (every pose sees the same
 // plane, the table turns in it, and one pose holds thousands of table readings), known before
@@ -18,15 +18,15 @@
 #include <utility>
 #include <vector>
 
+#include "pipeline/core/stage_laps.h"
+#include "pipeline/frames/multipath_correction.h"
+#include "pipeline/frames/prepare_pose.h"
+#include "pipeline/io/session.h"
 #include "pipeline/measure_config.h"
-#include "pipeline/multipath_correction.h"
-#include "pipeline/object_views.h"
-#include "pipeline/prepare_pose.h"
 #include "pipeline/refusal.h"
-#include "pipeline/session.h"
-#include "pipeline/stage_laps.h"
-#include "pipeline/table_plane.h"
-#include "pipeline/view_registration.h"
+#include "pipeline/registration/view_registration.h"
+#include "pipeline/views/object_views.h"
+#include "pipeline/views/table_plane.h"
 
 namespace boxd {
 

@@ -4,6 +4,10 @@
 # `boxd` system user the unit runs as and register the unit with deb-systemd-helper. Lintian
 # accepts it (tests/daemon/cli/package_test.cpp runs it).
 
+# cpack packs what was built; it does not build first (a package made while the tests run must
+# not relink the binaries they run).
+set(CMAKE_SKIP_INSTALL_ALL_DEPENDENCY TRUE)
+
 # Who answers for the package: -DBOXD_PACKAGE_MAINTAINER="Name <address>", else the git identity
 # of the tree the package is built from.
 execute_process(COMMAND git -C ${PROJECT_SOURCE_DIR} config user.name

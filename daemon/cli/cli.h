@@ -5,7 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 namespace CLI {
 class App;

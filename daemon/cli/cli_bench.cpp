@@ -18,8 +18,8 @@
 #include <vector>
 
 #include "daemon/cli/cli.h"
+#include "pipeline/io/session_io.h"
 #include "pipeline/measure_pipeline.h"
-#include "pipeline/session_io.h"
 
 namespace boxd::cli {
 

@@ -9,8 +9,8 @@
 #include "calibration/station_calibrator.h"
 #include "daemon/cli/cli.h"
 #include "daemon/cli/cli_progress.h"
-#include "pipeline/json_text.h"
-#include "pipeline/session_io.h"
+#include "pipeline/core/json_text.h"
+#include "pipeline/io/session_io.h"
 
 namespace boxd::cli {
 

@@ -5,7 +5,7 @@
 
 #include "daemon/cli/cli.h"
 #include "drivers/usb_devices.h"
-#include "pipeline/json_text.h"
+#include "pipeline/core/json_text.h"
 
 namespace boxd::cli {
 

@@ -8,10 +8,10 @@
 #include "daemon/cli/cli_progress.h"
 #include "daemon/service/daemon_config.h"
 #include "drivers/station_config.h"
-#include "pipeline/json_text.h"
+#include "pipeline/core/json_text.h"
+#include "pipeline/io/ply_writer.h"
+#include "pipeline/io/session_io.h"
 #include "pipeline/measure_pipeline.h"
-#include "pipeline/ply_writer.h"
-#include "pipeline/session_io.h"
 
 namespace boxd::cli {
 

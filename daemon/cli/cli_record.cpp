@@ -14,8 +14,8 @@
 #include "drivers/capture_loop.h"
 #include "drivers/driver_registry.h"
 #include "drivers/station_config.h"
-#include "pipeline/json_text.h"
-#include "pipeline/session_io.h"
+#include "pipeline/core/json_text.h"
+#include "pipeline/io/session_io.h"
 
 namespace boxd::cli {
 

@@ -15,8 +15,8 @@
 #include "daemon/cli/cli.h"
 #include "drivers/sim/synthetic_objects.h"
 #include "drivers/sim/synthetic_station.h"
-#include "pipeline/json_text.h"
-#include "pipeline/session_io.h"
+#include "pipeline/core/json_text.h"
+#include "pipeline/io/session_io.h"
 
 namespace boxd::cli {
 

@@ -2,7 +2,7 @@
 
 #include "daemon/service/measurement_store.h"
 #include "daemon/service/sqlite_db.h"
-#include "pipeline/json_text.h"
+#include "pipeline/core/json_text.h"
 
 namespace boxd {
 

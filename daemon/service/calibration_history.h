@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "calibration/station_calibrator.h"
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 struct sqlite3;
 

@@ -7,8 +7,8 @@
 #include <filesystem>
 #include <string>
 
+#include "pipeline/core/result.h"
 #include "pipeline/measure_config.h"
-#include "pipeline/result.h"
 
 namespace YAML {
 class Node;
@@ -90,7 +90,7 @@ Result<MqttConfig> ParseMqttConfig(const YAML::Node& node);
 // station's word on what the measurement may assume and report. `max_uncertainty_m` (a larger
 // 95% bound is refused UNCERTAIN) and `calibration_center_sigma_m` (how well the station's
 // calibration placed the table's centre: where no alignment fixes the centre, the bounds rest on
-// it; pipeline/pose_graph.h).
+// it; pipeline/registration/pose_graph.h).
 Status ParseMeasurementConfig(const YAML::Node& node, MeasureConfig& config);
 // Returns the defaults with the `measurement:` section of the config file at `file` applied
 // (what `boxd measure --config` replays a station's sessions with). INVALID_INPUT naming the

@@ -4,9 +4,9 @@
 
 #include <chrono>
 
+#include "pipeline/io/ply_writer.h"
+#include "pipeline/io/session_io.h"
 #include "pipeline/measure_pipeline.h"
-#include "pipeline/ply_writer.h"
-#include "pipeline/session_io.h"
 
 namespace boxd {
 

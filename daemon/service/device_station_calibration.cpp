@@ -8,8 +8,8 @@
 #include "calibration/station_calibrator.h"
 #include "daemon/service/device_station.h"
 #include "daemon/service/service_json.h"
-#include "pipeline/json_text.h"
-#include "pipeline/station_calibration_json.h"
+#include "pipeline/core/json_text.h"
+#include "pipeline/io/station_calibration_json.h"
 
 namespace boxd {
 

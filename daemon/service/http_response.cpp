@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "daemon/service/service_json.h"
-#include "pipeline/json_text.h"
+#include "pipeline/core/json_text.h"
 
 namespace boxd {
 

@@ -16,7 +16,7 @@
 #include <optional>
 #include <string>
 
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 namespace boxd {
 
@@ -44,6 +44,7 @@ std::optional<bool> BoolParam(const httplib::Request& req, const char* name);
 // BAD_REQUEST and returns nullopt: a body that is not a JSON object, or one with a key not in
 // `keys` (a misspelt key would otherwise be dropped in silence), named with the keys it may have.
 std::optional<nlohmann::json> JsonObjectBody(const httplib::Request& req, httplib::Response& res,
-                                             bool required, std::initializer_list<const char*> keys);
+                                             bool required,
+                                             std::initializer_list<const char*> keys);
 
 }  // namespace boxd

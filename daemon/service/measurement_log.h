@@ -1,7 +1,7 @@
 #pragma once
 // The daemon's one log line per finished measurement.
 
-#include "pipeline/measurement.h"
+#include "pipeline/io/measurement.h"
 
 namespace boxd {
 

@@ -20,7 +20,7 @@
 #include "daemon/service/measurement_store.h"
 #include "daemon/service/service_metrics.h"
 #include "daemon/service/station.h"
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 namespace boxd {
 

@@ -6,7 +6,7 @@
 #include <cstdio>
 
 #include "daemon/service/sqlite_db.h"
-#include "pipeline/json_text.h"
+#include "pipeline/core/json_text.h"
 
 namespace boxd {
 
@@ -43,8 +43,9 @@ Status MoveInto(const fs::path& from, const fs::path& to) {
 Status AddParcelIdColumn(sqlite3* db) {
     bool present = false;
     {
-        SqlStatement q(db, "SELECT 1 FROM pragma_table_info('measurements')"
-                           " WHERE name = 'parcel_id';");
+        SqlStatement q(db,
+                       "SELECT 1 FROM pragma_table_info('measurements')"
+                       " WHERE name = 'parcel_id';");
         if (!q.prepared()) return SqlError(db, "cannot read the measurements table's columns");
         present = q.Step() == SQLITE_ROW;
     }
@@ -55,7 +56,8 @@ Status AddParcelIdColumn(sqlite3* db) {
     if (!present && !exec("ALTER TABLE measurements ADD COLUMN parcel_id TEXT;")) {
         return SqlError(db, "cannot add the parcel_id column");
     }
-    if (!exec("CREATE INDEX IF NOT EXISTS measurements_by_parcel ON measurements (parcel_id, seq);")) {
+    if (!exec("CREATE INDEX IF NOT EXISTS measurements_by_parcel ON measurements (parcel_id, "
+              "seq);")) {
         return SqlError(db, "cannot index the parcel ids");
     }
     return OkStatus();

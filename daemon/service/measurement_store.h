@@ -13,8 +13,8 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/measurement.h"
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
+#include "pipeline/io/measurement.h"
 
 struct sqlite3;
 

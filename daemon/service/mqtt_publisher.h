@@ -20,7 +20,7 @@
 
 #include "daemon/service/daemon_config.h"
 #include "daemon/service/service_metrics.h"
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 struct mosquitto;
 
@@ -69,17 +69,18 @@ private:
     std::string status_topic_, measurements_topic_;
     mosquitto* client_ = nullptr;
     bool loop_started_ = false;
-    int connect_failures_ = 0;   // first connection attempts that failed (Start, connector_)  // written by Start's thread or connector_, read after joining it
+    int connect_failures_ = 0;  // first connection attempts that failed (Start, connector_)  //
+                                // written by Start's thread or connector_, read after joining it
     std::thread connector_;
     mutable std::mutex mutex_;
     std::condition_variable flushed_;  // an acknowledgement arrived
     bool connected_ = false;
     bool stopped_ = false;
-    std::deque<Pending> backlog_;         // not yet handed to libmosquitto
-    std::map<int, Pending> in_flight_;    // handed over, waiting for the PUBACK, by message id
-    std::string state_;                   // the retained state to (re)send
+    std::deque<Pending> backlog_;       // not yet handed to libmosquitto
+    std::map<int, Pending> in_flight_;  // handed over, waiting for the PUBACK, by message id
+    std::string state_;                 // the retained state to (re)send
     bool state_sent_ = false;
-    int offline_mid_ = -1;                // the goodbye's message id while Stop() waits for it
+    int offline_mid_ = -1;  // the goodbye's message id while Stop() waits for it
     bool offline_acked_ = false;
     long long published_ = 0, dropped_ = 0;
 };

@@ -5,23 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "pipeline/parallel_for.h"
+#include "pipeline/core/parallel_for.h"
 
 namespace boxd {
-
-double WidestGapDeg(std::vector<double> angles_deg) {
-    if (angles_deg.size() < 2) return 360.0;
-    for (double& a : angles_deg) {
-        a = std::fmod(a, 360.0);
-        if (a < 0.0) a += 360.0;
-    }
-    std::sort(angles_deg.begin(), angles_deg.end());
-    double widest = angles_deg.front() + 360.0 - angles_deg.back();
-    for (std::size_t i = 1; i < angles_deg.size(); ++i) {
-        widest = std::max(widest, angles_deg[i] - angles_deg[i - 1]);
-    }
-    return widest;
-}
 
 PosePreparer::PosePreparer(MeasureConfig config, const Session& header,
                            std::vector<double> plan_deg, double target_uncertainty_m,
@@ -60,11 +46,10 @@ void PosePreparer::Work() {
         Job job = std::move(queue_.front());
         queue_.pop_front();
         lock.unlock();
-        waiting_.emplace(job.index, PreparePose(job.frames, job.depth_unit_m, config_));
+        waiting_.emplace(job.index, PreparePose(job.frames, job.depth_unit_m, config_.Frames()));
         // The stream takes the poses in order; a pose ahead of its turn waits for the others.
         for (auto it = waiting_.find(static_cast<std::size_t>(stream_.Added()));
-             it != waiting_.end();
-             it = waiting_.find(static_cast<std::size_t>(stream_.Added()))) {
+             it != waiting_.end(); it = waiting_.find(static_cast<std::size_t>(stream_.Added()))) {
             stream_.Add(std::move(it->second));
             waiting_.erase(it);
             streamed_.store(stream_.Added());
@@ -95,7 +80,7 @@ void PosePreparer::TryDetermine() {
         if (!queue_.empty() || stop_) return;  // a newer pose is here: measure with it
     }
     const std::vector<double> angles(plan_deg_.begin(), plan_deg_.begin() + added);
-    if (WidestGapDeg(angles) > kSurroundGapDeg) return done(false, INFINITY, std::nullopt);
+    if (!SurroundsObject(angles)) return done(false, INFINITY, std::nullopt);
     std::unique_ptr<ViewStream> so_far = stream_.SoFar();
     if (!so_far) return done(false, INFINITY, std::nullopt);
     Session session = header_;
@@ -103,18 +88,10 @@ void PosePreparer::TryDetermine() {
     for (double a : angles) session.poses.push_back(SessionPose{a, {}, {}});
     auto out = MeasureStreamed(session, *so_far, config_, method_, SteadyClockMs());
     if (!out) return done(true, INFINITY, std::nullopt);
-    const MeasurementResult& r = out->result;
-    // Only a cuboid whose every face was told flat: a face's envelope is blind where too few
-    // views saw it (few poses leave its cells one view each), and a bulge or a strap it cannot
-    // see would be measured at the mean plane with a confident bound.
-    const bool cuboid = r.status == MeasurementStatus::kOk && r.shape == "cuboid" &&
-                        r.uncertainty_m && r.quality.face_flatness &&
-                        *r.quality.face_flatness <= kFlatFaces;
-    const double worst = cuboid ? std::max({r.uncertainty_m->length_m, r.uncertainty_m->width_m,
-                                            r.uncertainty_m->height_m})
-                                : INFINITY;
+    const double worst = DeterminingBound(out->result);
     spdlog::debug("pose stream: {} poses measure {}, worst 95% bound {:.2f} mm", added,
-                  cuboid ? "a cuboid" : "no cuboid", worst * 1e3);
+                  std::isfinite(worst) ? "a flat-faced cuboid" : "no flat-faced cuboid",
+                  worst * 1e3);
     if (!(worst <= target_m_)) return done(true, worst, std::nullopt);
     // The stages the stream did pose by pose count in their laps, as in MeasureStreamed.
     out->result.timing_ms["preprocess"] += stream_.segment_ms();
@@ -126,8 +103,7 @@ bool PosePreparer::ShouldStop(int captured) {
     if (target_m_ <= 0.0) return false;
     if (determined_.load()) return true;
     const auto n = std::min(static_cast<std::size_t>(std::max(captured, 0)), plan_deg_.size());
-    if (WidestGapDeg({plan_deg_.begin(), plan_deg_.begin() + static_cast<long>(n)}) >
-        kSurroundGapDeg) {
+    if (!SurroundsObject({plan_deg_.begin(), plan_deg_.begin() + static_cast<long>(n)})) {
         return false;
     }
     std::unique_lock lock(mutex_);
@@ -188,10 +164,11 @@ ViewStream& PosePreparer::Finish(const Session& session) {
         if (auto it = waiting_.find(i); it != waiting_.end()) {
             rest[static_cast<std::size_t>(k)] = std::move(it->second);
         } else if (const Job* job = queued[static_cast<std::size_t>(k)]) {
-            rest[static_cast<std::size_t>(k)] = PreparePose(job->frames, job->depth_unit_m, config_);
+            rest[static_cast<std::size_t>(k)] =
+                PreparePose(job->frames, job->depth_unit_m, config_.Frames());
         } else {
             rest[static_cast<std::size_t>(k)] =
-                PreparePose(session.poses[i].frames, session.camera.depth_unit_m, config_);
+                PreparePose(session.poses[i].frames, session.camera.depth_unit_m, config_.Frames());
         }
     });
     waiting_.clear();

@@ -6,10 +6,9 @@
 // remain (MeasureStreamed).
 //
 // With an uncertainty target, the worker also measures the poses so far after each one, once
-// they surround the object (no two neighbouring views more than kSurroundGapDeg apart, so that
-// every side face has been seen within half of that of head-on), and the measurement is
-// determined when that result is a cuboid whose every 95% bound is within the target: the
-// capture can stop turning. Irregular and uncertain objects never are, and take every pose.
+// they surround the object, and tells the capture when the pipeline's early-stop rule
+// (pipeline/early_stop.h) finds that measurement determined: the capture can stop turning.
+// Irregular and uncertain objects never are, and take every pose.
 
 #include <atomic>
 #include <condition_variable>
@@ -21,27 +20,16 @@
 #include <utility>
 #include <vector>
 
+#include "pipeline/early_stop.h"
+#include "pipeline/frames/prepare_pose.h"
 #include "pipeline/measure_pipeline.h"
-#include "pipeline/prepare_pose.h"
 #include "pipeline/view_stream.h"
 
 namespace boxd {
 
-// The widest gap between neighbouring views around the turn (degrees) that still counts as
-// surrounding the object.
-inline constexpr double kSurroundGapDeg = 90.0;
-// The largest quality.face_flatness (chi-square per cell) that counts as flat faces: several
-// hundred cells of a flat face give 1 within a few tenths (cells of a real box, whose views
-// disagree by the registration's tenths of a millimetre, up to about 2); a 3 mm bulge or a
-// 2 mm strap gives 4 to 50.
-inline constexpr double kFlatFaces = 2.5;
 // A measurement so far whose worst bound came within this factor of the target makes the
 // capture wait for the next one before it turns on.
 inline constexpr double kCloseFactor = 2.0;
-
-// Returns the widest gap between neighbouring angles around the turn, in degrees (360 for
-// fewer than two).
-double WidestGapDeg(std::vector<double> angles_deg);
 
 class PosePreparer {
 public:

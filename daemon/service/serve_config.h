@@ -1,6 +1,6 @@
 #pragma once
-// The whole config file of `boxd serve`: the daemon's `server:`, `storage:` and `mqtt:` sections plus
-// the station's `turntable:`, `camera:`, `capture:` and `calibration:` sections, with the
+// The whole config file of `boxd serve`: the daemon's `server:`, `storage:` and `mqtt:` sections
+// plus the station's `turntable:`, `camera:`, `capture:` and `calibration:` sections, with the
 // command line's --listen / --data-dir applied on top.
 
 #include <filesystem>
@@ -9,7 +9,7 @@
 
 #include "daemon/service/daemon_config.h"
 #include "daemon/service/device_station.h"
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 namespace boxd {
 

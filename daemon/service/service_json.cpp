@@ -1,6 +1,6 @@
 #include "daemon/service/service_json.h"
 
-#include "pipeline/station_calibration_json.h"
+#include "pipeline/io/station_calibration_json.h"
 
 namespace boxd {
 

@@ -1,13 +1,13 @@
 #pragma once
 // The JSON of the service's own types, one function per type, used by the HTTP API (and by the
-// station for its calibration file). The measurement's JSON is pipeline/measurement.h's ToJson,
-// the station calibration's pipeline/station_calibration_json.h's.
+// station for its calibration file). The measurement's JSON is pipeline/io/measurement.h's ToJson,
+// the station calibration's pipeline/io/station_calibration_json.h's.
 
 #include <nlohmann/json.hpp>
 
 #include "daemon/service/measurement_service.h"
 #include "daemon/service/station.h"
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 namespace boxd {
 

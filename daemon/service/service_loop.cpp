@@ -15,7 +15,7 @@
 #include "daemon/service/service_json.h"
 #include "daemon/service/signal_flags.h"
 #include "daemon/service/systemd_notifier.h"
-#include "pipeline/json_text.h"
+#include "pipeline/core/json_text.h"
 
 namespace boxd {
 

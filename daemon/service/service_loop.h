@@ -7,7 +7,7 @@
 #include <filesystem>
 
 #include "daemon/service/serve_config.h"
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 namespace boxd {
 

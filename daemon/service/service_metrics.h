@@ -10,15 +10,15 @@
 #include <optional>
 #include <string>
 
-#include "pipeline/error_code.h"
-#include "pipeline/measurement.h"
+#include "pipeline/core/error_code.h"
+#include "pipeline/io/measurement.h"
 
 namespace boxd {
 
 // A Prometheus histogram: cumulative counts over fixed upper bounds, their sum and count.
 struct Histogram {
     // Upper bounds (seconds): a station's cycle runs 2-10 s, its processing 0.05-2 s.
-    static constexpr std::array<double, 12> kBounds = {0.05, 0.1, 0.15, 0.25, 0.5, 1.0,
+    static constexpr std::array<double, 12> kBounds = {0.05, 0.1, 0.15, 0.25, 0.5,  1.0,
                                                        2.0,  3.0, 5.0,  10.0, 30.0, 60.0};
     std::array<long long, kBounds.size()> buckets{};  // observations <= each bound
     long long count = 0;
@@ -37,7 +37,7 @@ struct MqttStats {
 
 // What the exposition needs beyond the counters, read by the caller at request time.
 struct MetricsContext {
-    const char* state = "idle";          // ServiceStateName of the service's state
+    const char* state = "idle";                  // ServiceStateName of the service's state
     std::optional<long long> calibration_age_s;  // nullopt: no calibration, or its age unknown
     bool calibrated = false;
     long long uptime_s = 0;

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 namespace boxd {
 

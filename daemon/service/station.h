@@ -12,10 +12,10 @@
 
 #include "calibration/station_calibrator.h"
 #include "daemon/service/measurement_store.h"
-#include "pipeline/measurement.h"
-#include "pipeline/result.h"
-#include "pipeline/session.h"
-#include "pipeline/station_calibration.h"
+#include "pipeline/core/result.h"
+#include "pipeline/core/station_calibration.h"
+#include "pipeline/io/measurement.h"
+#include "pipeline/io/session.h"
 
 namespace boxd {
 

@@ -12,20 +12,20 @@
 // (a point source gives each pixel's patch the same flux I / f^2, whatever its distance and
 // slope; theta: the angles between PQ and the two normals, r = |PQ|, iota_P: P's incidence).
 // The lit patches are the pixels the camera sees, so the sum runs over a grid of the image's own
-// rays (the sum itself is the pipeline's, pipeline/multipath_correction.h, which takes the error
-// out again: here the rays' exact surfaces feed it, there the readings). A plane does not light
-// itself (theta = 90 degrees) and a convex surface does not face itself: the error is the concave
-// corner's, where a wall meets the table, largest at the foot and falling off up the wall and
-// across the table (Fuchs, "Multipath interference compensation in time-of-flight camera images",
-// ICPR 2010; Jimenez et al., "Modeling and correction of multipath interference in time of flight
-// cameras", Image and Vision Computing 32, 2014). Occlusion between P and Q is not traced: on an
-// object standing on a table the surfaces that face each other see each other.
+// rays (the sum itself is the pipeline's, pipeline/frames/multipath_correction.h, which takes the
+// error out again: here the rays' exact surfaces feed it, there the readings). A plane does not
+// light itself (theta = 90 degrees) and a convex surface does not face itself: the error is the
+// concave corner's, where a wall meets the table, largest at the foot and falling off up the wall
+// and across the table (Fuchs, "Multipath interference compensation in time-of-flight camera
+// images", ICPR 2010; Jimenez et al., "Modeling and correction of multipath interference in time of
+// flight cameras", Image and Vision Computing 32, 2014). Occlusion between P and Q is not traced:
+// on an object standing on a table the surfaces that face each other see each other.
 
 #include <vector>
 
 #include "drivers/sim/synthetic_geometry.h"
-#include "pipeline/camera.h"
-#include "pipeline/multipath_correction.h"
+#include "pipeline/core/camera.h"
+#include "pipeline/frames/multipath_correction.h"
 
 namespace boxd {
 

@@ -10,7 +10,7 @@
 #include <limits>
 #include <string>
 
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 namespace boxd {
 

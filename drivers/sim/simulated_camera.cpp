@@ -5,7 +5,7 @@
 #include <random>
 #include <thread>
 
-#include "pipeline/mix_bits.h"
+#include "pipeline/core/mix_bits.h"
 
 namespace boxd {
 

@@ -10,7 +10,7 @@
 
 #include "drivers/sim/synthetic_station.h"
 #include "drivers/sim/triangle_mesh.h"
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 namespace boxd {
 

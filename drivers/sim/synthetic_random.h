@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "pipeline/mix_bits.h"
+#include "pipeline/core/mix_bits.h"
 
 namespace boxd::synthetic_random {
 

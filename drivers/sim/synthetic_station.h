@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "drivers/sim/sensor_noise.h"
-#include "pipeline/result.h"
-#include "pipeline/session.h"
+#include "pipeline/core/result.h"
+#include "pipeline/io/session.h"
 
 namespace boxd {
 

@@ -33,7 +33,7 @@
 #include <memory>
 #include <string>
 
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 namespace boxd {
 

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "drivers/sim/synthetic_station.h"
-#include "pipeline/student_t.h"
+#include "pipeline/core/student_t.h"
 #include "tests/support/run_command.h"
 #include "tests/support/temp_dir.h"
 

@@ -15,7 +15,7 @@
 
 #include "drivers/sim/synthetic_station.h"
 #include "drivers/station_config.h"
-#include "pipeline/session_io.h"
+#include "pipeline/io/session_io.h"
 #include "tests/support/child_process.h"
 #include "tests/support/run_command.h"
 #include "tests/support/temp_dir.h"
@@ -83,8 +83,8 @@ TEST(BoxdRecord, SimulatedStationMatchesSynthOfTheSameScene) {
                               (dir / "recorded").string()});
     ASSERT_EQ(rec.exit_code, 0) << rec.err;
     // Its progress on stderr, a line per pose (not a terminal here), up to the last.
-    const std::string last = "boxd: record: captured " + std::to_string(kPoses) + " of " +
-                             std::to_string(kPoses) + "\n";
+    const std::string last =
+        "boxd: record: captured " + std::to_string(kPoses) + " of " + std::to_string(kPoses) + "\n";
     EXPECT_NE(rec.err.find("boxd: record: captured 1 of "), std::string::npos) << rec.err;
     EXPECT_NE(rec.err.find(last), std::string::npos) << rec.err;
     const auto summary = nlohmann::json::parse(rec.out);

@@ -11,7 +11,7 @@
 #include "drivers/replay_turntable.h"
 #include "drivers/sim/synthetic_station.h"
 #include "drivers/station_config.h"
-#include "pipeline/session_io.h"
+#include "pipeline/io/session_io.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd {

@@ -7,7 +7,7 @@
 #include <cstdint>
 #include <string_view>
 
-#include "pipeline/session_io.h"
+#include "pipeline/io/session_io.h"
 #include "tests/fuzz/fuzz_dir.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {

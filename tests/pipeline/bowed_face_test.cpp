@@ -1,7 +1,7 @@
-// Known-answer tests of a face's smooth crest (pipeline/bowed_face.h) on hand-made cell grids:
-// a panel bowing out, a flat face, a tilted one, one whose edges roll away, a patch the fit does
-// not follow, too few cells and a crest under the views' disagreement.
-#include "pipeline/bowed_face.h"
+// Known-answer tests of a face's smooth crest (pipeline/envelope/bowed_face.h) on hand-made cell
+// grids: a panel bowing out, a flat face, a tilted one, one whose edges roll away, a patch the fit
+// does not follow, too few cells and a crest under the views' disagreement.
+#include "pipeline/envelope/bowed_face.h"
 
 #include <gtest/gtest.h>
 

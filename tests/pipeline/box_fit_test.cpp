@@ -1,4 +1,4 @@
-#include "pipeline/box_fit.h"
+#include "pipeline/fit/box_fit.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "pipeline/camera.h"
+#include "pipeline/core/camera.h"
 
 #include <gtest/gtest.h>
 

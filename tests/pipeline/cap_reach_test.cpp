@@ -1,7 +1,7 @@
-// Known-answer tests of a cap's crest read across cells (pipeline/cap_reach.h): a dome is read at
-// its vertex without the bias of the largest cell, a flat face and a straight crest are left to
-// the cells.
-#include "pipeline/cap_reach.h"
+// Known-answer tests of a cap's crest read across cells (pipeline/envelope/cap_reach.h): a dome is
+// read at its vertex without the bias of the largest cell, a flat face and a straight crest are
+// left to the cells.
+#include "pipeline/envelope/cap_reach.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
-// The unseen feet of a cuboid's side faces (pipeline/cuboid_foot.h): a carton whose +x side
-// reads nothing in its lowest 30 mm, where it flares out by 4 mm, with the table read from its
+// The unseen feet of a cuboid's side faces (pipeline/envelope/cuboid_foot.h): a carton whose +x
+// side reads nothing in its lowest 30 mm, where it flares out by 4 mm, with the table read from its
 // true foot outward; the same carton read down to the band; and with no table beyond.
-#include "pipeline/cuboid_foot.h"
+#include "pipeline/envelope/cuboid_foot.h"
 
 #include <gtest/gtest.h>
 

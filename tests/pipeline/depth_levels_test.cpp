@@ -1,4 +1,4 @@
-#include "pipeline/depth_levels.h"
+#include "pipeline/frames/depth_levels.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <random>
 
 #include "drivers/sim/synthetic_station.h"
-#include "pipeline/frame_averaging.h"
+#include "pipeline/frames/frame_averaging.h"
 
 namespace boxd {
 namespace {

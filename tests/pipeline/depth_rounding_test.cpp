@@ -1,4 +1,4 @@
-#include "pipeline/depth_rounding.h"
+#include "pipeline/views/depth_rounding.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
 // Known-answer tests of the smallest enclosing cuboid on hand-made fused clouds
 // (tests/support/envelope_clouds.h): an ideal box, a box whose long sides bulge, a standing
 // tube, an L-shaped pack, a carton with a panel standing up and a cloud too thin to bound.
-#include "pipeline/enclosing_cuboid.h"
+#include "pipeline/envelope/enclosing_cuboid.h"
 
 #include <gtest/gtest.h>
 
@@ -14,7 +14,7 @@
 #include <utility>
 #include <vector>
 
-#include "pipeline/student_t.h"
+#include "pipeline/core/student_t.h"
 #include "tests/support/envelope_clouds.h"
 #include "tests/support/expect_error.h"
 

@@ -7,8 +7,8 @@
 #include <random>
 #include <vector>
 
-#include "pipeline/enclosing_cuboid.h"
-#include "pipeline/support_envelope.h"
+#include "pipeline/envelope/enclosing_cuboid.h"
+#include "pipeline/envelope/support_envelope.h"
 #include "tests/support/envelope_clouds.h"
 
 namespace boxd {

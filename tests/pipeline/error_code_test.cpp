@@ -1,4 +1,4 @@
-#include "pipeline/error_code.h"
+#include "pipeline/core/error_code.h"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
-// Known-answer tests of a face's cells (pipeline/face_envelope.h) on a hand-made top: every view
-// reads the face with its own shift and the sensor's noise, most cells with a dozen readings a
-// view and a quarter of it with one or two (a corner some views see obliquely, a stretch where the
-// fused cloud keeps few pixels).
-#include "pipeline/face_envelope.h"
+// Known-answer tests of a face's cells (pipeline/envelope/face_envelope.h) on a hand-made top:
+// every view reads the face with its own shift and the sensor's noise, most cells with a dozen
+// readings a view and a quarter of it with one or two (a corner some views see obliquely, a stretch
+// where the fused cloud keeps few pixels).
+#include "pipeline/envelope/face_envelope.h"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
-// Known-answer tests of the windows that stand out of a face (pipeline/face_windows.h) on
+// Known-answer tests of the windows that stand out of a face (pipeline/envelope/face_windows.h) on
 // hand-made grids of cells read by a few views: a flat face, a strap no single cell shows, a
 // label, a face whose cells all sit above its plane and lean from it, and a patch the views
 // disagree about.
-#include "pipeline/face_windows.h"
+#include "pipeline/envelope/face_windows.h"
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
-// Known-answer tests of the foot band (pipeline/foot_band.h): a wall's outer layer read from the
-// band's top up, as the support function bins it, and where the extension puts the wall's foot
-// on the table — a flank sloping outward (a prism's, a frustum's), an upright wall, an undercut
-// one, a wall nothing read near the table (raised) or read too sparsely there, and a bending
-// profile, over several seeds.
-#include "pipeline/foot_band.h"
+// Known-answer tests of the foot band (pipeline/envelope/foot_band.h): a wall's outer layer read
+// from the band's top up, as the support function bins it, and where the extension puts the wall's
+// foot on the table — a flank sloping outward (a prism's, a frustum's), an upright wall, an
+// undercut one, a wall nothing read near the table (raised) or read too sparsely there, and a
+// bending profile, over several seeds.
+#include "pipeline/envelope/foot_band.h"
 
 #include <gtest/gtest.h>
 

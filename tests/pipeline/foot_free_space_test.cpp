@@ -1,9 +1,9 @@
-// Known-answer tests of the free space beside a foot (pipeline/foot_free_space.h): a wall whose
-// lowest readings stand above a dark band, the table read from its true foot outward with the
+// Known-answer tests of the free space beside a foot (pipeline/envelope/foot_free_space.h): a wall
+// whose lowest readings stand above a dark band, the table read from its true foot outward with the
 // noise of rays falling at 40 degrees, strays inside the foot, a strip with no table beyond, and
 // the spread of a table reading for the cameras' elevation; and the envelope of a prism whose
 // base reads nothing, with the table read beside it and without.
-#include "pipeline/foot_free_space.h"
+#include "pipeline/envelope/foot_free_space.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <random>
 #include <vector>
 
-#include "pipeline/support_envelope.h"
+#include "pipeline/envelope/support_envelope.h"
 
 namespace boxd::envelope {
 namespace {

@@ -1,4 +1,4 @@
-#include "pipeline/frame_averaging.h"
+#include "pipeline/frames/frame_averaging.h"
 
 #include <gtest/gtest.h>
 
@@ -97,9 +97,9 @@ TEST(AverageDepthFrames, MatchesThePlainRuleOnRandomReadingsForEveryFrameCount) 
         for (std::size_t i = 0; i < frames[0].pixels.size(); ++i) {
             std::vector<std::uint16_t> readings;
             for (const auto& f : frames) readings.push_back(f.pixels[i]);
-            ASSERT_FLOAT_EQ(avg->z_m[i],
-                            ReferenceAverage(readings, 0.001, std::max<std::size_t>(1, required),
-                                             config))
+            ASSERT_FLOAT_EQ(
+                avg->z_m[i],
+                ReferenceAverage(readings, 0.001, std::max<std::size_t>(1, required), config))
                 << n << " frames, pixel " << i;
         }
     }

@@ -1,4 +1,4 @@
-#include "pipeline/fuse_and_fit.h"
+#include "pipeline/fit/fuse_and_fit.h"
 
 #include <gtest/gtest.h>
 
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/nearest_grid.h"
+#include "pipeline/core/nearest_grid.h"
 #include "tests/support/box_on_turntable.h"
 
 namespace boxd {

@@ -1,4 +1,4 @@
-#include "pipeline/fusion.h"
+#include "pipeline/fit/fusion.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "pipeline/icp.h"
+#include "pipeline/registration/icp.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <random>
 
-#include "pipeline/registration_cloud.h"
+#include "pipeline/views/registration_cloud.h"
 
 namespace boxd {
 namespace {

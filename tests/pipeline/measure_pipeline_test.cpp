@@ -11,7 +11,7 @@
 #include <string>
 
 #include "drivers/sim/synthetic_station.h"
-#include "pipeline/session_io.h"
+#include "pipeline/io/session_io.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd {
@@ -40,7 +40,8 @@ TEST(MeasurePrepared, GivesTheNumbersOfMeasureSession) {
     // Poses prepared one at a time, in reverse order, as a capture thread might.
     std::vector<PreparedPose> prepared(session.poses.size());
     for (std::size_t i = session.poses.size(); i-- > 0;) {
-        prepared[i] = PreparePose(session.poses[i].frames, session.camera.depth_unit_m, config);
+        prepared[i] =
+            PreparePose(session.poses[i].frames, session.camera.depth_unit_m, config.Frames());
     }
     auto streamed = MeasurePrepared(session, std::move(prepared), config, BoxMethod::kFootprint);
     ASSERT_TRUE(streamed.ok());
@@ -98,9 +99,10 @@ TEST(MeasurePrepared, RefusesPosesItCannotUse) {
     // A pose whose frames could not be averaged is INSUFFICIENT_DATA, naming the pose.
     std::vector<PreparedPose> prepared(session.poses.size());
     for (std::size_t i = 0; i < prepared.size(); ++i) {
-        prepared[i] = PreparePose(session.poses[i].frames, session.camera.depth_unit_m, config);
+        prepared[i] =
+            PreparePose(session.poses[i].frames, session.camera.depth_unit_m, config.Frames());
     }
-    prepared[3] = PreparePose({}, session.camera.depth_unit_m, config);
+    prepared[3] = PreparePose({}, session.camera.depth_unit_m, config.Frames());
     auto r = MeasurePrepared(session, std::move(prepared), config, BoxMethod::kFootprint);
     ASSERT_TRUE(r.ok());
     EXPECT_EQ(r->result.status, MeasurementStatus::kNoDim);

@@ -1,4 +1,4 @@
-#include "pipeline/measurement.h"
+#include "pipeline/io/measurement.h"
 
 #include <gtest/gtest.h>
 

@@ -1,8 +1,8 @@
-// A time-of-flight camera's multipath taken out of a view (pipeline/multipath_correction.h):
+// A time-of-flight camera's multipath taken out of a view (pipeline/frames/multipath_correction.h):
 // the synthetic station renders an exact view with and without its multipath; corrected from its
 // own readings, the view's surfaces come back to within a tenth of the error, and a camera
 // without multipath is left alone.
-#include "pipeline/multipath_correction.h"
+#include "pipeline/frames/multipath_correction.h"
 
 #include <gtest/gtest.h>
 

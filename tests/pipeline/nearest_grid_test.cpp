@@ -1,4 +1,4 @@
-#include "pipeline/nearest_grid.h"
+#include "pipeline/core/nearest_grid.h"
 
 #include <gtest/gtest.h>
 

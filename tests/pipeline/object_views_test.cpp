@@ -1,10 +1,10 @@
-#include "pipeline/object_views.h"
+#include "pipeline/views/object_views.h"
 
 #include <gtest/gtest.h>
 
 #include <vector>
 
-#include "pipeline/view_registration.h"
+#include "pipeline/registration/view_registration.h"
 #include "tests/support/down_camera.h"
 
 namespace boxd {

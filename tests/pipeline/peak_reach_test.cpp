@@ -1,8 +1,8 @@
-// Known-answer tests of a sharp top (pipeline/peak_reach.h): a pyramid whose last millimetres no
-// view read, a prism's ridge, and tops that are not sharp — a flat top, a bag's gentle crown, an
-// upright panel's edge — each read by 18 views on their own jittered 2 mm grids with 1 mm of
-// noise in height.
-#include "pipeline/peak_reach.h"
+// Known-answer tests of a sharp top (pipeline/envelope/peak_reach.h): a pyramid whose last
+// millimetres no view read, a prism's ridge, and tops that are not sharp — a flat top, a bag's
+// gentle crown, an upright panel's edge — each read by 18 views on their own jittered 2 mm grids
+// with 1 mm of noise in height.
+#include "pipeline/envelope/peak_reach.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "pipeline/ply_writer.h"
+#include "pipeline/io/ply_writer.h"
 
 #include <gtest/gtest.h>
 

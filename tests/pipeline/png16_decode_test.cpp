@@ -1,7 +1,7 @@
 // The fast path of ReadPng16 (libdeflate, png16_decode.h) against PNGs libpng writes in every
 // form a depth frame may come in: each row filter, several IDAT chunks, interlaced (which is
 // handed back to libpng), and damaged files.
-#include "pipeline/png16_decode.h"
+#include "pipeline/io/png16_decode.h"
 
 #include <gtest/gtest.h>
 #include <png.h>
@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/png16.h"
+#include "pipeline/io/png16.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd {

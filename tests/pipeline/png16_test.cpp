@@ -1,6 +1,6 @@
 // 16-bit PNG frames through libpng: what is written reads back bit for bit, OpenCV reads it the
 // same, and other images are refused with the session format's messages.
-#include "pipeline/png16.h"
+#include "pipeline/io/png16.h"
 
 #include <gtest/gtest.h>
 
@@ -38,7 +38,8 @@ TEST(Png16, ReadsWhatOpenCvWrites) {
     test::TempDir dir;
     cv::Mat mat(4, 5, CV_16UC1);
     for (int y = 0; y < 4; ++y) {
-        for (int x = 0; x < 5; ++x) mat.at<std::uint16_t>(y, x) = static_cast<std::uint16_t>(1000 * y + x);
+        for (int x = 0; x < 5; ++x)
+            mat.at<std::uint16_t>(y, x) = static_cast<std::uint16_t>(1000 * y + x);
     }
     ASSERT_TRUE(cv::imwrite((dir / "cv.png").string(), mat));
     auto back = ReadPng16(dir / "cv.png", 5, 4);

@@ -1,4 +1,4 @@
-#include "pipeline/pose_graph.h"
+#include "pipeline/registration/pose_graph.h"
 
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <random>
 
-#include "pipeline/student_t.h"
+#include "pipeline/core/student_t.h"
 
 namespace boxd {
 namespace {

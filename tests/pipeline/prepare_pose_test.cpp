@@ -1,4 +1,4 @@
-#include "pipeline/prepare_pose.h"
+#include "pipeline/frames/prepare_pose.h"
 
 #include <gtest/gtest.h>
 
@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "pipeline/refusal.h"
 #include "tests/support/expect_error.h"
 
 namespace boxd {
@@ -48,7 +49,7 @@ PreparedPose Prepared(DepthMap depth) { return PreparedPose{std::move(depth), ""
 
 TEST(PreparePose, IdenticalFramesGiveTheirDepthInMetres) {
     const std::vector<DepthImage> frames(5, Ramp(900));
-    const PreparedPose p = PreparePose(frames, 0.001, MeasureConfig{});
+    const PreparedPose p = PreparePose(frames, 0.001, FrameConfig{});
     EXPECT_TRUE(p.error.empty()) << p.error;
     ExpectRampInMetres(p.depth, 900, 0.001);
 }
@@ -56,7 +57,7 @@ TEST(PreparePose, IdenticalFramesGiveTheirDepthInMetres) {
 TEST(PreparePose, UsesTheCameraDepthUnit) {
     // The same raw values at 0.5 mm per unit read half as deep.
     const std::vector<DepthImage> frames(3, Ramp(1800));
-    const PreparedPose p = PreparePose(frames, 0.0005, MeasureConfig{});
+    const PreparedPose p = PreparePose(frames, 0.0005, FrameConfig{});
     EXPECT_TRUE(p.error.empty()) << p.error;
     ExpectRampInMetres(p.depth, 1800, 0.0005);
 }
@@ -67,7 +68,7 @@ TEST(PreparePose, RemovesFlyingPixelsAsConfigured) {
     DepthImage img = Ramp(900);
     img.at(7, 5) = 800;
     const std::vector<DepthImage> frames(3, img);
-    MeasureConfig config;
+    FrameConfig config;
     const PreparedPose filtered = PreparePose(frames, 0.001, config);
     ASSERT_TRUE(filtered.error.empty()) << filtered.error;
     EXPECT_EQ(filtered.depth.at(7, 5), 0.0f);
@@ -78,11 +79,11 @@ TEST(PreparePose, RemovesFlyingPixelsAsConfigured) {
 }
 
 TEST(PreparePose, FramesThatCannotBeAveragedGiveAnError) {
-    const PreparedPose none = PreparePose({}, 0.001, MeasureConfig{});
+    const PreparedPose none = PreparePose({}, 0.001, FrameConfig{});
     EXPECT_FALSE(none.error.empty());
     EXPECT_TRUE(none.depth.z_m.empty());
     const PreparedPose mixed =
-        PreparePose({Ramp(900), DepthImage(kW + 1, kH)}, 0.001, MeasureConfig{});
+        PreparePose({Ramp(900), DepthImage(kW + 1, kH)}, 0.001, FrameConfig{});
     EXPECT_FALSE(mixed.error.empty());
     EXPECT_TRUE(mixed.depth.z_m.empty());
 }
@@ -106,7 +107,7 @@ Session FivePoses() {
 
 TEST(PrepareSession, PreparesEveryPoseInOrderOnOneAndTwoThreads) {
     const Session session = FivePoses();
-    MeasureConfig config;
+    FrameConfig config;
     config.threads = 1;
     const std::vector<PreparedPose> one = PrepareSession(session, config);
     config.threads = 2;

@@ -1,4 +1,4 @@
-#include "pipeline/register_views.h"
+#include "pipeline/registration/register_views.h"
 
 #include <gtest/gtest.h>
 

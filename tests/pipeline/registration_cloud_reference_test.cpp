@@ -12,8 +12,8 @@
 #include <algorithm>
 #include <random>
 
-#include "pipeline/nearest_grid.h"
-#include "pipeline/registration_cloud.h"
+#include "pipeline/core/nearest_grid.h"
+#include "pipeline/views/registration_cloud.h"
 
 namespace boxd {
 namespace {

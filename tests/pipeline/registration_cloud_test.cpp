@@ -1,4 +1,4 @@
-#include "pipeline/registration_cloud.h"
+#include "pipeline/views/registration_cloud.h"
 
 #include <gtest/gtest.h>
 
@@ -38,7 +38,8 @@ RegistrationCloudConfig NoOutlierRemoval(double voxel_m) {
 }
 
 TEST(BuildRegistrationCloud, VoxelCentroidsOfAKnownGrid) {
-    const OrientedPoints cloud = BuildRegistrationCloud(FlatGrid(), NoOutlierRemoval(0.006), kAbove);
+    const OrientedPoints cloud =
+        BuildRegistrationCloud(FlatGrid(), NoOutlierRemoval(0.006), kAbove);
     // 0.12 m / 6 mm = 20 voxels per side; each centroid is its voxel's centre (3 x 3 points).
     ASSERT_EQ(cloud.points.size(), 400u);
     ASSERT_EQ(cloud.normals.size(), 400u);

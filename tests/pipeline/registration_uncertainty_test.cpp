@@ -1,4 +1,4 @@
-#include "pipeline/registration_uncertainty.h"
+#include "pipeline/envelope/registration_uncertainty.h"
 
 #include <gtest/gtest.h>
 
@@ -65,8 +65,8 @@ TEST(RegistrationSigma, ViewsThatMoveTogetherDoNotChangeTheSize) {
 
 TEST(RegistrationSigma, NothingToPropagateIsZero) {
     const FusedCloud cloud = SidesFromThreeViews(-0.14, 0.14);
-    const auto none = RegistrationSigma(cloud, Footprint(), std::vector<Se2>(3),
-                                        Eigen::MatrixXd::Zero(9, 9));
+    const auto none =
+        RegistrationSigma(cloud, Footprint(), std::vector<Se2>(3), Eigen::MatrixXd::Zero(9, 9));
     EXPECT_EQ(none[0], 0.0);
     EXPECT_EQ(none[1], 0.0);
     EXPECT_EQ(RegistrationSigma(cloud, Footprint(), std::vector<Se2>(1), Eigen::MatrixXd())[0],

@@ -1,4 +1,4 @@
-#include "pipeline/rounded_edges.h"
+#include "pipeline/fit/rounded_edges.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "pipeline/se2.h"
+#include "pipeline/core/se2.h"
 
 #include <gtest/gtest.h>
 

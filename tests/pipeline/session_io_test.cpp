@@ -1,4 +1,4 @@
-#include "pipeline/session_io.h"
+#include "pipeline/io/session_io.h"
 
 #include <gtest/gtest.h>
 

@@ -1,7 +1,7 @@
-// Known-answer tests of one view's enclosing cuboid (pipeline/single_view_cuboid.h): the
+// Known-answer tests of one view's enclosing cuboid (pipeline/envelope/single_view_cuboid.h): the
 // cuboid it assumes from the top's edges, and what the sides it shows say against it or about
 // the ones it hides: a part wider below the top, a part above it, a curved side, a strap.
-#include "pipeline/single_view_cuboid.h"
+#include "pipeline/envelope/single_view_cuboid.h"
 
 #include <gtest/gtest.h>
 
@@ -9,8 +9,8 @@
 #include <random>
 #include <string>
 
-#include "pipeline/box_fit.h"
-#include "pipeline/student_t.h"
+#include "pipeline/core/student_t.h"
+#include "pipeline/fit/box_fit.h"
 #include "tests/support/envelope_clouds.h"
 #include "tests/support/expect_error.h"
 

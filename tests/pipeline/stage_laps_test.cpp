@@ -1,4 +1,4 @@
-#include "pipeline/stage_laps.h"
+#include "pipeline/core/stage_laps.h"
 
 #include <gtest/gtest.h>
 

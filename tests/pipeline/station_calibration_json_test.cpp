@@ -1,6 +1,6 @@
 // The station calibration's JSON codec: what ToJson writes, StationCalibrationFromJson reads back
 // exactly; a broken field is refused with its name.
-#include "pipeline/station_calibration_json.h"
+#include "pipeline/io/station_calibration_json.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "pipeline/station_calibration.h"
+#include "pipeline/core/station_calibration.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "pipeline/student_t.h"
+#include "pipeline/core/student_t.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "pipeline/table_plane.h"
+#include "pipeline/views/table_plane.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "pipeline/view_registration.h"
+#include "pipeline/registration/view_registration.h"
 
 #include <gtest/gtest.h>
 

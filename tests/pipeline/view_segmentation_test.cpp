@@ -1,4 +1,4 @@
-#include "pipeline/view_segmentation.h"
+#include "pipeline/views/view_segmentation.h"
 
 #include <gtest/gtest.h>
 

@@ -26,7 +26,7 @@ TEST(ViewStream, OneByOneMeasuresExactlyAsAllAtOnce) {
     const Session session = Render(21, 8);
     const MeasureConfig config;
     ViewStream one(session, session.PoseAnglesDeg(), config);
-    std::vector<PreparedPose> prepared = PrepareSession(session, config);
+    std::vector<PreparedPose> prepared = PrepareSession(session, config.Frames());
     for (std::size_t i = 0; i < prepared.size(); ++i) {
         one.Add(std::move(prepared[i]));
         EXPECT_EQ(one.Added(), static_cast<int>(i) + 1);
@@ -60,7 +60,7 @@ TEST(ViewStream, ACopySoFarKeepsTheMultipathItsBoundCarries) {
     ASSERT_GT(session->calibration.multipath_albedo, 0.0);
     const MeasureConfig config;
     ViewStream stream(*session, session->PoseAnglesDeg(), config);
-    std::vector<PreparedPose> prepared = PrepareSession(*session, config);
+    std::vector<PreparedPose> prepared = PrepareSession(*session, config.Frames());
     for (int i = 0; i < 3; ++i) stream.Add(std::move(prepared[static_cast<std::size_t>(i)]));
     ASSERT_GT(stream.multipath().walls_m, 0.0);
     const std::unique_ptr<ViewStream> copy = stream.SoFar();
@@ -73,7 +73,7 @@ TEST(ViewStream, AnUnusablePoseIsRefusedByNameWhateverFollows) {
     const Session session = Render(22, 4);
     const MeasureConfig config;
     ViewStream stream(session, session.PoseAnglesDeg(), config);
-    std::vector<PreparedPose> prepared = PrepareSession(session, config);
+    std::vector<PreparedPose> prepared = PrepareSession(session, config.Frames());
     prepared[2].error = "the camera returned no frames";
     for (std::size_t i = 0; i < prepared.size(); ++i) {
         stream.Add(std::move(prepared[i]));
@@ -89,7 +89,7 @@ TEST(ViewStream, APoseHidingTheTableWaitsForTheNextOnes) {
     // pose 1 is in, from both poses' candidates, and pose 0's view is cut then.
     const Session session = Render(23, 6);
     const MeasureConfig config;
-    std::vector<PreparedPose> prepared = PrepareSession(session, config);
+    std::vector<PreparedPose> prepared = PrepareSession(session, config.Frames());
     for (float& z : prepared[0].depth.z_m) {
         if (z > 0.0f) z += 0.5f;
     }
@@ -107,7 +107,7 @@ TEST(ViewStream, AStreamOfOtherPosesIsNotMeasuredAsTheSession) {
     const Session session = Render(24, 4);
     const MeasureConfig config;
     ViewStream stream(session, session.PoseAnglesDeg(), config);
-    std::vector<PreparedPose> prepared = PrepareSession(session, config);
+    std::vector<PreparedPose> prepared = PrepareSession(session, config.Frames());
     for (std::size_t i = 0; i < 3; ++i) {
         stream.Add(std::move(prepared[i]));
     }

@@ -9,8 +9,8 @@
 #include <random>
 #include <vector>
 
-#include "pipeline/point_cloud.h"
-#include "pipeline/se2.h"
+#include "pipeline/core/point_cloud.h"
+#include "pipeline/core/se2.h"
 
 namespace boxd::test {
 

@@ -5,7 +5,7 @@
 
 #include <Eigen/Geometry>
 
-#include "pipeline/camera.h"
+#include "pipeline/core/camera.h"
 
 namespace boxd::test {
 

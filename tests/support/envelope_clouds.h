@@ -17,12 +17,12 @@
 #include <utility>
 #include <vector>
 
-#include "pipeline/box_fit.h"
-#include "pipeline/enclosing_cuboid.h"
-#include "pipeline/fusion.h"
-#include "pipeline/icp.h"
-#include "pipeline/registration_cloud.h"
-#include "pipeline/view_registration.h"
+#include "pipeline/envelope/enclosing_cuboid.h"
+#include "pipeline/fit/box_fit.h"
+#include "pipeline/fit/fusion.h"
+#include "pipeline/registration/icp.h"
+#include "pipeline/registration/view_registration.h"
+#include "pipeline/views/registration_cloud.h"
 
 namespace boxd::test {
 

@@ -3,7 +3,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pipeline/result.h"
+#include "pipeline/core/result.h"
 
 namespace boxd::test {
 

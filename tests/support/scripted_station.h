@@ -77,7 +77,12 @@ public:
         return devices;
     }
     CalibrationInForce Calibration() const override {
-        return CalibrationInForce{StationCalibration{}, "calibration.json", 42};
+        CalibrationInForce c;
+        c.calibration = StationCalibration{};
+        c.source = "calibration.json";
+        c.age_s = 42;
+        c.calibrated_at = "2026-01-01T00:00:00.000Z";
+        return c;
     }
 
 private:

@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "pipeline/session_io.h"
+#include "pipeline/io/session_io.h"
 #include "tests/support/run_command.h"
 #include "tests/support/temp_dir.h"
 

@@ -31,7 +31,7 @@ void Hand(PosePreparer& preparer, const Session& session, std::size_t i) {
 
 // Returns the session's measurement through a stream fed all at once.
 MeasurementResult AllAtOnce(const Session& session, const MeasureConfig& config) {
-    auto out = MeasurePrepared(session, PrepareSession(session, config), config,
+    auto out = MeasurePrepared(session, PrepareSession(session, config.Frames()), config,
                                BoxMethod::kFootprint);
     EXPECT_TRUE(out.ok());
     return out->result;
@@ -79,8 +79,8 @@ TEST(PosePreparer, StopsCleanlyWithWorkQueued) {
     SyntheticStationConfig c;
     auto session = RenderSyntheticSession(c, 2, 1);
     ASSERT_TRUE(session.ok());
-    auto preparer = std::make_unique<PosePreparer>(MeasureConfig{}, *session,
-                                                   session->PoseAnglesDeg());
+    auto preparer =
+        std::make_unique<PosePreparer>(MeasureConfig{}, *session, session->PoseAnglesDeg());
     for (int k = 0; k < 20; ++k) {
         preparer->Add(static_cast<std::size_t>(k % 2), session->poses[0].frames,
                       session->camera.depth_unit_m);
@@ -91,14 +91,6 @@ TEST(PosePreparer, StopsCleanlyWithWorkQueued) {
     ViewStream& stream = idle.Finish(*session);
     EXPECT_EQ(stream.Added(), 2);
     EXPECT_TRUE(stream.Matches(*session));
-}
-
-TEST(WidestGapDeg, IsTheLargestTurnBetweenNeighbouringViews) {
-    EXPECT_DOUBLE_EQ(WidestGapDeg({0.0}), 360.0);
-    EXPECT_DOUBLE_EQ(WidestGapDeg({0.0, 180.0}), 180.0);
-    EXPECT_DOUBLE_EQ(WidestGapDeg({0.0, 60.0, 120.0, 180.0, 240.0}), 120.0);  // 240 back to 360
-    EXPECT_DOUBLE_EQ(WidestGapDeg({0.0, -60.0, -120.0, -180.0, -240.0, -300.0}), 60.0);
-    EXPECT_DOUBLE_EQ(WidestGapDeg({350.0, 10.0, 370.0}), 340.0);  // 370 is 10 again
 }
 
 // Returns a simulated session of a 400 x 300 x 250 box whose poses come in the coverage
@@ -112,8 +104,7 @@ Session CoverageOrdered(double bulge_m = 0.0) {
     c.box.height_m = 0.25;
     c.box.yaw_deg = 20.0;
     auto session = RenderSyntheticSession(
-        c, {0, 60, 120, 180, 240, 300, 340, 320, 280, 260, 220, 200, 160, 140, 100, 80, 40, 20},
-        2);
+        c, {0, 60, 120, 180, 240, 300, 340, 320, 280, 260, 220, 200, 160, 140, 100, 80, 40, 20}, 2);
     EXPECT_TRUE(session.ok());
     return session.ok() ? *session : Session{};
 }
@@ -194,8 +185,8 @@ TEST(PosePreparer, AnUnreachableTargetTakesEveryPose) {
     auto streamed = MeasureStreamed(session, stream, config, BoxMethod::kFootprint);
     ASSERT_TRUE(streamed.ok());
     // Captured in coverage order, measured as the same poses around the turn in order.
-    EXPECT_NEAR(streamed->result.dimensions->length_m, AllAtOnce(session, config).dimensions->length_m,
-                1e-9);
+    EXPECT_NEAR(streamed->result.dimensions->length_m,
+                AllAtOnce(session, config).dimensions->length_m, 1e-9);
 }
 
 }  // namespace

@@ -1,0 +1,145 @@
+#include "pipeline/envelope/foot_band.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+#include <optional>
+#include <vector>
+
+namespace boxd::envelope {
+
+namespace {
+
+// How many standard errors an outward slope must stand clear of zero to be extended: a wall
+// that is upright within its noise is not moved by it.
+constexpr double kSlopeSigmas = 3.0;
+
+// The rows of the wall's profile read above the band: five 12 mm rows, 60 mm of the wall.
+constexpr int kProfileRows = 5;
+
+// A row's outermost judged cell: its mean reach, less the median of the largest of as many
+// noise draws as cells compete for it (the largest of many noisy means stands out by that much),
+// its standard error and its readings' mean height.
+struct RowReach {
+    double s = 0.0, se = 0.0, z = 0.0;
+};
+
+std::optional<RowReach> OutermostInRow(const CellGrid<LayerCell>& layer, int row,
+                                       const EnvelopeConfig& config) {
+    const LayerCell* best = nullptr;
+    const auto cell = [&](int i) -> const LayerCell& {
+        return layer.cells[static_cast<std::size_t>(row) * static_cast<std::size_t>(layer.na) +
+                           static_cast<std::size_t>(i)];
+    };
+    for (int i = 0; i < layer.na; ++i) {
+        const LayerCell& c = cell(i);
+        if (c.n >= config.min_cell_points && (!best || c.Mean() > best->Mean())) best = &c;
+    }
+    if (!best) return std::nullopt;
+    int contenders = 0;
+    for (int i = 0; i < layer.na; ++i) {
+        const LayerCell& c = cell(i);
+        contenders += c.n >= config.min_cell_points &&
+                      c.Mean() >= best->Mean() - 2.0 * (c.StdError() + best->StdError());
+    }
+    return RowReach{best->Mean() - MedianOfLargest(contenders) * best->StdError(), best->StdError(),
+                    best->Centroid().y()};
+}
+
+// A weighted least-squares polynomial through rows (z, s, se): its value and standard error at
+// the table (z = 0), and its slope (ds/dz at the rows' mean height) with its standard error,
+// both widened by the fit's reduced chi-square where the rows stray from it.
+struct PolyFit {
+    double at_table = 0.0, at_table_se = 0.0, slope = 0.0, slope_se = 0.0;
+};
+
+std::optional<PolyFit> FitRows(const std::vector<RowReach>& rows, int degree) {
+    const int n = static_cast<int>(rows.size()), m = degree + 1;
+    if (n <= degree) return std::nullopt;
+    Eigen::MatrixXd a(n, m);
+    Eigen::VectorXd y(n), w(n);
+    double zbar = 0.0;
+    for (const RowReach& r : rows) zbar += r.z / n;
+    for (int i = 0; i < n; ++i) {
+        for (int k = 0; k < m; ++k) a(i, k) = std::pow(rows[i].z, k);
+        y(i) = rows[i].s;
+        w(i) = 1.0 / std::max(rows[i].se * rows[i].se, 1e-12);
+    }
+    const Eigen::MatrixXd normal = a.transpose() * w.asDiagonal() * a;
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(normal);
+    if (ldlt.info() != Eigen::Success) return std::nullopt;
+    const Eigen::VectorXd coef = ldlt.solve(a.transpose() * w.asDiagonal() * y);
+    const Eigen::MatrixXd cov = ldlt.solve(Eigen::MatrixXd::Identity(m, m));
+    const Eigen::VectorXd r = y - a * coef;
+    const double chi2 = r.dot(w.asDiagonal() * r);
+    const double scale = n > m ? std::sqrt(std::max(1.0, chi2 / (n - m))) : 1.0;
+    // d/dz at zbar: the gradient of the polynomial's derivative with respect to its coefficients.
+    Eigen::VectorXd g = Eigen::VectorXd::Zero(m);
+    for (int k = 1; k < m; ++k) g(k) = k * std::pow(zbar, k - 1);
+    PolyFit out;
+    out.at_table = coef(0);
+    out.at_table_se = scale * std::sqrt(cov(0, 0));
+    out.slope = -g.dot(coef);  // outward per metre, going down
+    out.slope_se = scale * std::sqrt(g.dot(cov * g));
+    return out;
+}
+
+// Whether the rows between the band and row `first` hold fewer readings than one judged cell:
+// nothing read the wall there (a few strays aside), rather than too few readings to judge a
+// cell (the narrow foot of a lying tube's round end).
+bool NothingReadBelow(const CellGrid<LayerCell>& layer, int first, const EnvelopeConfig& config) {
+    long readings = 0;
+    for (int j = 0; j < first; ++j) {
+        if (layer.b0 + (j + 1) * layer.db <= config.min_z_m + 1e-9) continue;  // within the band
+        for (int i = 0; i < layer.na; ++i) {
+            readings += layer.cells[static_cast<std::size_t>(j) * layer.na + i].n;
+        }
+    }
+    return readings < config.min_cell_points;
+}
+
+}  // namespace
+
+FootReach ExtrapolateFoot(const CellGrid<LayerCell>& layer, const EnvelopeConfig& config) {
+    FootReach out;
+    // The lowest row holding a judged cell: the first above the band, or higher where nothing
+    // read the wall's foot (foot_free_space.h says how far it may go).
+    int first = -1;
+    for (int j = 0; j < layer.nb && first < 0; ++j) {
+        if (OutermostInRow(layer, j, config)) first = j;
+    }
+    if (first < 0) return out;
+    // A wall read below its lowest judged row, too sparsely to judge (the narrow foot of a lying
+    // tube's round end), or standing on something (an overhang), has no foot to extend.
+    const bool at_band = layer.b0 + first * layer.db <= config.min_z_m + 1e-9;
+    out.above_band = !at_band;
+    out.raised = !at_band && NothingReadBelow(layer, first, config);
+    if (!at_band && !out.raised) return out;
+    // The wall's profile: its lowest rows, one after another, as far as kProfileRows.
+    std::vector<RowReach> rows;
+    for (int j = first; j < layer.nb && j < first + kProfileRows; ++j) {
+        const auto r = OutermostInRow(layer, j, config);
+        if (!r) break;
+        rows.push_back(*r);
+    }
+    if (rows.size() < 3) return out;
+    const auto line = FitRows(rows, 1);
+    // The profile above its lowest row must slope outward too: one row standing out alone is no
+    // flank (a silhouette's few stray readings beside an upright tube at its foot).
+    const auto upper = FitRows(std::vector<RowReach>(rows.begin() + 1, rows.end()), 1);
+    if (!line || !upper || !(line->slope > kSlopeSigmas * line->slope_se) ||
+        !(upper->slope > kSlopeSigmas * upper->slope_se)) {
+        return out;
+    }
+    out.slope = line->slope;
+    out.reach = line->at_table;
+    double variance = line->at_table_se * line->at_table_se;
+    // A profile that bends may go on bending through the band: where a parabola fits the rows,
+    // how far its foot lies from the line's counts as one standard error.
+    if (const auto curve = FitRows(rows, 2)) {
+        variance += std::pow(curve->at_table - line->at_table, 2);
+    }
+    out.se = std::sqrt(variance);
+    return out;
+}
+
+}  // namespace boxd::envelope

@@ -1,0 +1,179 @@
+#include "pipeline/envelope/peak_reach.h"
+
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <map>
+#include <numeric>
+#include <optional>
+
+#include "pipeline/core/median.h"
+#include "pipeline/core/student_t.h"
+#include "pipeline/envelope/surface_cells.h"
+
+namespace boxd::envelope {
+
+namespace {
+
+// Flanks rising less than this (27 degrees) make a low crown, which the top's cells read.
+constexpr double kMinSlope = 0.5;
+// The highest readings, whose mean is the apex point; the third highest is the height they hold.
+constexpr std::size_t kApexReadings = 5;
+// A top whose readings spread this many times farther one way than the other is a ridge.
+constexpr double kRidgeElongation = 4.0;
+// The readings of a view whose nearest neighbours give its spacing (an even sample).
+constexpr std::size_t kSpacingSamples = 200;
+// The top's readings in bins of drop, each needing this many to count.
+constexpr int kDropBins = 6;
+constexpr std::size_t kBinReadings = 5;
+// Flanks steeper than this (84 degrees) are walls: the top is their edge, read as it stands.
+constexpr double kMaxSlope = 10.0;
+
+// The median over views of the median distance from a reading of the top to the nearest other
+// reading of the same view (all readings as one view where `view` is empty): how finely a view
+// samples the surface across its rays there (on a steep flank the readings stack nearly
+// straight up, their horizontal spacing a fraction of it).
+double ViewSpacing(const std::vector<Eigen::Vector3f>& top,
+                   const std::vector<std::uint16_t>& view) {
+    std::map<int, std::vector<Eigen::Vector3f>> by_view;
+    for (std::size_t i = 0; i < top.size(); ++i) {
+        by_view[view.empty() ? 0 : view[i]].push_back(top[i]);
+    }
+    std::vector<double> spacings;
+    for (const auto& [v, q] : by_view) {
+        if (q.size() < 3) continue;
+        std::vector<double> nearest;
+        // At most kSpacingSamples readings a view are asked for their nearest neighbour.
+        const std::size_t step = std::max<std::size_t>(1, q.size() / kSpacingSamples);
+        for (std::size_t i = 0; i < q.size(); i += step) {
+            double best = INFINITY;
+            for (std::size_t j = 0; j < q.size(); ++j) {
+                if (j != i) best = std::min(best, static_cast<double>((q[i] - q[j]).norm()));
+            }
+            nearest.push_back(best);
+        }
+        spacings.push_back(Median(nearest));
+    }
+    return spacings.empty() ? 0.0 : Median(spacings);
+}
+
+// The flanks' slope from how the top widens going down: the readings in kDropBins bins of
+// their drop below `highest`, each bin's median distance from the apex point (or across the
+// ridge line), a line through (drop, distance) by least squares: a flank rising s metres per
+// metre runs 1/s metre out per metre down. A top already `narrow_m` wide where it is highest
+// (a face), one that does not widen (a panel's edge, its width its thickness), or widens as a
+// smooth crown does, has none.
+std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top,
+                                 const Eigen::Vector2d& apex, const Eigen::Vector2d* across,
+                                 double highest, double band_m, double narrow_m) {
+    std::vector<std::vector<double>> bins(kDropBins);
+    for (const Eigen::Vector3f& p : top) {
+        const Eigen::Vector2d q = p.head<2>().cast<double>() - apex;
+        const int bin = static_cast<int>((highest - p.z()) / band_m * kDropBins);
+        if (bin < 0 || bin >= kDropBins) continue;
+        bins[static_cast<std::size_t>(bin)].push_back(across ? std::abs(across->dot(q)) : q.norm());
+    }
+    std::vector<double> x, y;
+    for (int b = 0; b < kDropBins; ++b) {
+        if (bins[static_cast<std::size_t>(b)].size() < kBinReadings) continue;
+        x.push_back((b + 0.5) * band_m / kDropBins);
+        y.push_back(Median(bins[static_cast<std::size_t>(b)]));
+    }
+    const double n = static_cast<double>(x.size());
+    double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, sqx = 0.0, sqy = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        sx += x[i];
+        sy += y[i];
+        sxx += x[i] * x[i];
+        sxy += x[i] * y[i];
+        sqx += x[i];  // sqrt(x)^2
+        sqy += std::sqrt(x[i]) * y[i];
+    }
+    const double det = n * sxx - sx * sx;
+    if (n < 3.0 || !(det > 0.0)) return std::nullopt;
+    const double run = (n * sxy - sx * sy) / det;  // metres out per metre down
+    const double at_top = (sy - run * sx) / n;
+    // A smooth crown widens as the root of the drop (a radius of curvature r: d = sqrt(2 r drop)),
+    // a flank in proportion to it: the crown's model fitting better, it is no sharp top.
+    const double root = sqy / sqx;
+    double line_rss = 0.0, root_rss = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        line_rss += std::pow(y[i] - at_top - run * x[i], 2);
+        root_rss += std::pow(y[i] - root * std::sqrt(x[i]), 2);
+    }
+    if (!(line_rss < root_rss)) return std::nullopt;
+    // A top as wide as a cell where it is highest is a face, not a point or a line.
+    if (!(at_top <= narrow_m)) return std::nullopt;
+    if (!(run > 0.0) || !(1.0 / run > kMinSlope) || 1.0 / run > kMaxSlope) return std::nullopt;
+    return 1.0 / run;
+}
+
+}  // namespace
+
+PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
+                          const std::vector<std::uint16_t>& view, double noise_sigma, double band_m,
+                          double narrow_m, double narrowest_m) {
+    PeakReach out;
+    if (pts.size() < 20) return out;
+    std::vector<std::size_t> order(pts.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::partial_sort(order.begin(), order.begin() + kApexReadings, order.end(),
+                      [&](std::size_t a, std::size_t b) { return pts[a].z() > pts[b].z(); });
+    // The third highest reading (the two highest may be strays), less the median of the largest
+    // of as many noise draws as readings compete for it (a ridge's hundreds stand 3 sigma out).
+    const double third = pts[order[2]].z();
+    int competing = 0;
+    for (const Eigen::Vector3f& p : pts) competing += p.z() >= third - 2.0 * noise_sigma ? 1 : 0;
+    out.highest = third - noise_sigma * MedianOfLargest(std::max(1, competing));
+    Eigen::Vector2d apex = Eigen::Vector2d::Zero();
+    for (std::size_t i = 0; i < kApexReadings; ++i) {
+        apex += pts[order[i]].head<2>().cast<double>() / static_cast<double>(kApexReadings);
+    }
+    std::vector<Eigen::Vector3f> top;
+    std::vector<std::uint16_t> top_view;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+        if (pts[i].z() < out.highest - band_m) continue;
+        top.push_back(pts[i]);
+        if (i < view.size()) top_view.push_back(view[i]);
+    }
+    if (top.size() < 20) return out;
+    if (top_view.size() != top.size()) top_view.clear();
+    // A ridge when the top runs along one line: distances are then taken across it.
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+    for (const Eigen::Vector3f& p : top) {
+        const Eigen::Vector2d q = p.head<2>().cast<double>() - apex;
+        cov += q * q.transpose() / static_cast<double>(top.size());
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+    const bool ridge = eig.eigenvalues()(1) > kRidgeElongation * eig.eigenvalues()(0);
+    const Eigen::Vector2d across = eig.eigenvectors().col(0);
+    const auto slope =
+        FlankSlope(top, apex, ridge ? &across : nullptr, out.highest, band_m, narrow_m);
+    if (!slope) return out;
+    out.slope = *slope;
+    out.spacing = ViewSpacing(top, top_view);
+    out.above = out.slope * std::max(out.spacing, narrowest_m) / 2.0;
+    out.sharp = true;
+    return out;
+}
+
+void ReadSharpTop(const Surface& surface, double height_sigma, const EnvelopeConfig& config,
+                  double* height, double* se) {
+    const PeakReach peak =
+        ExtrapolatePeak(surface.points, surface.view, height_sigma, 2.0 * config.cell_height_m,
+                        config.cell_along_m, config.narrowest_kept_m);
+    if (!peak.sharp) return;
+    spdlog::debug(
+        "envelope: a sharp top, its highest readings {:.2f} mm above the cells', slope "
+        "{:.2f}, spacing {:.2f} mm",
+        (peak.highest - *height) * 1e3, peak.slope, peak.spacing * 1e3);
+    if (peak.highest > *height) {
+        *height = peak.highest;
+        *se = height_sigma;
+    }
+    *height += peak.above / 2.0;
+    *se = std::hypot(*se, peak.above / 2.0 / kNormal95);
+}
+
+}  // namespace boxd::envelope
