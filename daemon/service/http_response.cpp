@@ -69,8 +69,9 @@ std::optional<json> JsonObjectBody(const Request& req, Response& res, bool requi
         SetError(res, ErrorCode::kBadRequest, "the body must be a JSON object");
         return std::nullopt;
     }
-    for (const auto& [key, value] : body.items()) {
-        if (std::find_if(keys.begin(), keys.end(), [&](const char* k) { return key == k; }) !=
+    for (auto it = body.begin(); it != body.end(); ++it) {
+        const std::string& key = it.key();
+        if (std::find_if(keys.begin(), keys.end(), [&key](const char* k) { return key == k; }) !=
             keys.end()) {
             continue;
         }
