@@ -2,6 +2,8 @@
 // and an unknown command or option named as such, with the nearest valid one. CLI11 alone would
 // answer `boxd mesure` with "A subcommand is required" and `boxd measure --bogus` with the first
 // missing required option.
+#include <spdlog/fmt/ranges.h>
+
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
@@ -100,11 +102,9 @@ std::optional<Error> CheckArguments(const CLI::App& app, int argc, char** argv) 
     }
     const std::vector<std::string> commands = SubcommandNames(app);
     if (std::find(commands.begin(), commands.end(), first) == commands.end()) {
-        std::string list;
-        for (const std::string& c : commands) list += (list.empty() ? "" : ", ") + c;
-        return Error{ErrorCode::kInvalidInput, "unknown command '" + first + "'" +
-                                                   Suggestion(first, commands) +
-                                                   "; the commands are " + list};
+        return Error{ErrorCode::kInvalidInput,
+                     "unknown command '" + first + "'" + Suggestion(first, commands) +
+                         "; the commands are " + fmt::format("{}", fmt::join(commands, ", "))};
     }
     return UnknownOption(*app.get_subcommand(first), "boxd " + first, 2, argc, argv);
 }

@@ -84,7 +84,10 @@ private:
     std::string turntable_description_;
     std::string camera_description_;
     std::filesystem::path calibration_source_;  // the file the calibration in force came from
-    nlohmann::json calibration_run_;  // the run that made it (POST /v1/calibrate's), or null
+    // When the calibration in force was made and the run that made it (POST /v1/calibrate's:
+    // reference, quality, uncertainty); "" and null for a config's calibration section.
+    std::string calibrated_at_;
+    nlohmann::json calibration_run_;
     // When the last pose of the capture in progress was grabbed (the job thread's).
     std::chrono::steady_clock::time_point last_frame_at_;
 };

@@ -27,6 +27,16 @@ std::optional<long long> SecondsSince(const std::string& utc) {
     return static_cast<long long>(std::difftime(std::time(nullptr), then));
 }
 
+// Returns what GET /v1/calibration shows of the run `j` that made a calibration (a stored
+// calibration file, or the run's JSON): its reference, quality and uncertainty.
+nlohmann::json RunSummary(const nlohmann::json& j) {
+    nlohmann::json run = nlohmann::json::object();
+    for (const char* key : {"reference_m", "quality", "uncertainty"}) {
+        run[key] = j.value(key, nlohmann::json());
+    }
+    return run;
+}
+
 }  // namespace
 
 void DeviceStation::LoadStoredCalibration() {
@@ -55,7 +65,9 @@ void DeviceStation::LoadStoredCalibration() {
     }
     config_.station.calibration = *c;
     calibration_source_ = config_.calibration_file;
-    calibration_run_ = j;
+    calibrated_at_ =
+        j.value("calibrated_at", json()).is_string() ? j["calibrated_at"].get<std::string>() : "";
+    calibration_run_ = RunSummary(j);
     spdlog::info("calibration: using {} (from POST /v1/calibrate)",
                  config_.calibration_file.string());
 }
@@ -89,7 +101,8 @@ Result<CalibrationRun> DeviceStation::Calibrate(const JobContext& ctx,
     std::lock_guard lock(devices_mutex_);
     config_.station.calibration = run.report.calibration;
     calibration_source_ = config_.calibration_file;
-    calibration_run_ = ToJson(run);
+    calibrated_at_ = run.calibrated_at;
+    calibration_run_ = RunSummary(ToJson(run));
     if (devices_) {
         devices_->station.calibration = run.report.calibration;
         devices_->calibrated = true;
@@ -108,14 +121,10 @@ CalibrationInForce DeviceStation::Calibration() const {
     out.source = calibration_source_;
     // Its age is known when the run that made it is: a config's calibration section does not say
     // when it was made, and the file's time is only when the file was last edited.
-    if (calibration_run_.is_object() &&
-        calibration_run_.value("calibrated_at", json()).is_string()) {
-        out.calibrated_at = calibration_run_["calibrated_at"].get<std::string>();
-        out.age_s = SecondsSince(out.calibrated_at);
-        out.run = json::object();
-        for (const char* key : {"reference_m", "quality", "uncertainty"}) {
-            out.run[key] = calibration_run_.value(key, json());
-        }
+    if (!calibrated_at_.empty()) {
+        out.calibrated_at = calibrated_at_;
+        out.age_s = SecondsSince(calibrated_at_);
+        out.run = calibration_run_;
     }
     return out;
 }

@@ -1,5 +1,6 @@
 #include "daemon/service/http_response.h"
 
+#include <spdlog/fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -75,11 +76,9 @@ std::optional<json> JsonObjectBody(const Request& req, Response& res, bool requi
             keys.end()) {
             continue;
         }
-        std::string known;
-        for (const char* k : keys) known += std::string(known.empty() ? "" : ", ") + k;
-        SetError(
-            res, ErrorCode::kBadRequest,
-            "unknown key \"" + key.substr(0, 64) + "\" in the body (it may have: " + known + ")");
+        SetError(res, ErrorCode::kBadRequest,
+                 fmt::format("unknown key \"{}\" in the body (it may have: {})", key.substr(0, 64),
+                             fmt::join(keys, ", ")));
         return std::nullopt;
     }
     return body;

@@ -1,5 +1,7 @@
 #include "daemon/service/route_table.h"
 
+#include <spdlog/fmt/ranges.h>
+
 #include <algorithm>
 
 namespace boxd {
@@ -22,9 +24,7 @@ std::string RouteTable::AllowedMethods(const std::string& path) const {
         methods.push_back(method);
         if (method == "GET") methods.push_back("HEAD");
     }
-    std::string allow;
-    for (const std::string& m : methods) allow += (allow.empty() ? "" : ", ") + m;
-    return allow;
+    return fmt::format("{}", fmt::join(methods, ", "));
 }
 
 }  // namespace boxd
