@@ -4,11 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <utility>
 #include <vector>
 
-#include "pipeline/core/median.h"
+#include "pipeline/fit/footprint_parts.h"
 
 namespace boxd {
 
@@ -157,62 +156,22 @@ std::optional<MeasurementReason> CheckFusedFit(const FusedFit& fit, const Refusa
     return BoxFacesDisagree(fit, refuse);
 }
 
-// A footprint cell at the footprint's edge (a side neighbour empty) holding fewer than this share
-// of the footprint's median cell is a few readings carried off a surface, not a surface: mixed
-// pixels at the depth step between two objects, the noise at a wall's foot. Across the gap
-// between two parcels 2 cm apart single such readings, a cell each, joined the two footprints
-// into one, and the pair was measured as one object (a random pair sweep, 2 of 40). A surface
-// any view saw fills its cells by the fusion's density, a handful of points to hundreds: an
-// eighth of the median keeps every surface cell of the suite's objects, sparse RealSense tops
-// included, and drops the single stray readings. An edge cell only: inside the footprint a thin
-// cell joins nothing that is not joined already.
+// A footprint cell at the footprint's edge holding fewer than this share of the footprint's median
+// cell is a few readings carried off a surface, not a surface (footprint_parts.h): across the gap
+// between two parcels 2 cm apart single such readings joined the two footprints into one (a
+// random pair sweep, 2 of 40). An eighth of the median keeps every surface cell of the suite's
+// objects, sparse RealSense tops included, and drops the single stray readings.
 constexpr double kStrayShareOfMedian = 1.0 / 8.0;
 
 std::optional<MeasurementReason> CheckSingleObject(const FusedCloud& fused,
                                                    const RefusalConfig& refuse) {
-    // Occupied footprint cells above the table, their counts, then their 8-connected parts.
-    std::map<std::pair<int, int>, int> count;
-    const double inv = 1.0 / refuse.object_cell_m;
-    for (const Eigen::Vector3f& p : fused.points) {
-        if (p.z() < 2.0 * refuse.object_cell_m) continue;
-        ++count[{static_cast<int>(std::floor(p.x() * inv)),
-                 static_cast<int>(std::floor(p.y() * inv))}];
-    }
-    std::vector<double> counts;
-    counts.reserve(count.size());
-    for (const auto& [cell, n] : count) counts.push_back(n);
-    const double stray = kStrayShareOfMedian * Median(std::move(counts));
-    std::map<std::pair<int, int>, int> cell_part;
-    for (const auto& [cell, n] : count) {
-        const auto [x, y] = cell;
-        const bool edge = !count.count({x + 1, y}) || !count.count({x - 1, y}) ||
-                          !count.count({x, y + 1}) || !count.count({x, y - 1});
-        if (!(edge && n < stray)) cell_part[cell] = -1;
-    }
-    std::vector<int> part_cells;
-    for (auto& [cell, part] : cell_part) {
-        if (part >= 0) continue;
-        const int id = static_cast<int>(part_cells.size());
-        part_cells.push_back(0);
-        std::vector<std::pair<int, int>> stack = {cell};
-        part = id;
-        while (!stack.empty()) {
-            const auto [x, y] = stack.back();
-            stack.pop_back();
-            ++part_cells[static_cast<std::size_t>(id)];
-            for (int dx = -1; dx <= 1; ++dx) {
-                for (int dy = -1; dy <= 1; ++dy) {
-                    auto it = cell_part.find({x + dx, y + dy});
-                    if (it == cell_part.end() || it->second >= 0) continue;
-                    it->second = id;
-                    stack.push_back(it->first);
-                }
-            }
-        }
-    }
-    const double total = static_cast<double>(cell_part.size());
+    // Readings lower than two cells are the table's (a flat scrap is no object).
+    const FootprintParts parts = SeparateFootprint(fused.points, 2.0 * refuse.object_cell_m,
+                                                   refuse.object_cell_m, kStrayShareOfMedian);
     int objects = 0;
-    for (int cells : part_cells) objects += cells >= refuse.min_object_share * total ? 1 : 0;
+    for (double area : parts.area_m2) {
+        objects += area >= refuse.min_object_share * parts.total_m2 ? 1 : 0;
+    }
     if (objects < 2) return std::nullopt;
     return MeasurementReason{
         ErrorCode::kMultipleObjects,

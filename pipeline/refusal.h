@@ -32,8 +32,9 @@ struct RefusalConfig {
     // Box faces rougher than this (robust sigma of the face fits) are not faces of one rigid box
     // seen from registered views.
     double max_face_sigma_m = 0.01;
-    // Separate objects: footprint cells (of this size, 8-connected) that do not touch form
-    // separate objects; parts holding at least this share of the footprint count as objects.
+    // Separate objects: readings farther apart than this across the table, with no reading
+    // between, belong to separate parts of the footprint (footprint_parts.h); parts holding at
+    // least this share of the footprint count as objects.
     double object_cell_m = 0.01;
     double min_object_share = 0.05;
     // A dimension whose 95% uncertainty exceeds this is not reported: UNCERTAIN.
