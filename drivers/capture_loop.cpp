@@ -56,7 +56,6 @@ private:
     std::thread thread_;
 };
 
-
 // Sleeps `ms`, waking early when the capture is cancelled; returns false when cancelled.
 bool SleepUnlessCancelled(int ms, const CaptureCallbacks& cb) {
     const auto end = std::chrono::steady_clock::now() + std::chrono::milliseconds(ms);
@@ -166,6 +165,35 @@ bool StandsAt(Turntable& turntable, double angle_deg) {
            std::abs(state->angle_deg - angle_deg) < 0.01;
 }
 
+// Pose k's frames of n, the first `drop_frames` dropped: CANCELLED when the capture is cancelled
+// meanwhile, CAMERA_ERROR when a frame cannot be grabbed or is not of the camera's size.
+Result<SessionPose> GrabPose(DepthCamera& camera, const CaptureConfig& config,
+                             const CameraIntrinsics& intrinsics, int k, int n,
+                             const CaptureCallbacks& callbacks) {
+    const auto timeout = std::chrono::milliseconds(config.grab_timeout_ms);
+    SessionPose pose;
+    for (int f = 0; f < config.drop_frames + config.frames_per_pose; ++f) {
+        if (Cancelled(callbacks)) return Error{ErrorCode::kCancelled, "cancelled"};
+        auto frame = camera.Grab(timeout);
+        if (!frame) {
+            return Error{ErrorCode::kCameraError, "pose " + std::to_string(k + 1) + " of " +
+                                                      std::to_string(n) + ": " +
+                                                      frame.error().message};
+        }
+        if (frame->width != intrinsics.width || frame->height != intrinsics.height) {
+            return CameraError("pose " + std::to_string(k + 1) + ": frame is " +
+                               std::to_string(frame->width) + "x" + std::to_string(frame->height) +
+                               ", camera reports " + std::to_string(intrinsics.width) + "x" +
+                               std::to_string(intrinsics.height));
+        }
+        if (f < config.drop_frames) continue;
+        pose.frame_paths.push_back(
+            SessionFramePath(static_cast<std::size_t>(k), pose.frames.size()));
+        pose.frames.push_back(std::move(frame).value());
+    }
+    return pose;
+}
+
 }  // namespace
 
 Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
@@ -183,7 +211,6 @@ Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
 
     turntable.ClearStopRequest();
     CancelWatcher watcher(callbacks, turntable);
-    const auto timeout = std::chrono::milliseconds(config.grab_timeout_ms);
     auto cancelled = [&](int pose) -> Error {
         StopTable(turntable);
         return Error{ErrorCode::kCancelled, "capture cancelled at pose " +
@@ -215,33 +242,16 @@ Result<Session> CaptureSession(Turntable& turntable, DepthCamera& camera,
             return cancelled(k);
         }
 
-        SessionPose pose;
-        pose.angle_deg = relative;
-        for (int f = 0; f < config.drop_frames + config.frames_per_pose; ++f) {
-            if (Cancelled(callbacks)) return cancelled(k);
-            auto frame = camera.Grab(timeout);
-            if (!frame) {
-                StopTable(turntable);
-                return Error{ErrorCode::kCameraError, "pose " + std::to_string(k + 1) + " of " +
-                                                          std::to_string(n) + ": " +
-                                                          frame.error().message};
-            }
-            if (frame->width != session.camera.width || frame->height != session.camera.height) {
-                StopTable(turntable);
-                return CameraError("pose " + std::to_string(k + 1) + ": frame is " +
-                                   std::to_string(frame->width) + "x" +
-                                   std::to_string(frame->height) + ", camera reports " +
-                                   std::to_string(session.camera.width) + "x" +
-                                   std::to_string(session.camera.height));
-            }
-            if (f < config.drop_frames) continue;
-            pose.frame_paths.push_back(
-                SessionFramePath(static_cast<std::size_t>(k), pose.frames.size()));
-            pose.frames.push_back(std::move(frame).value());
+        auto pose = GrabPose(camera, config, session.camera, k, n, callbacks);
+        if (!pose) {
+            if (pose.error().code == ErrorCode::kCancelled) return cancelled(k);
+            StopTable(turntable);
+            return pose.error();
         }
+        pose->angle_deg = relative;
         spdlog::debug("capture: pose {} of {} at {:.2f} deg: {} frames", k + 1, n,
-                      sweep.start_deg + relative, pose.frames.size());
-        session.poses.push_back(std::move(pose));
+                      sweep.start_deg + relative, pose->frames.size());
+        session.poses.push_back(std::move(pose).value());
         if (callbacks.on_pose) callbacks.on_pose(session.poses.size() - 1, session.poses.back());
         if (k + 1 < n && callbacks.stop && callbacks.stop(k + 1)) {
             spdlog::debug("capture: stopped after pose {} of {}", k + 1, n);

@@ -123,6 +123,8 @@ struct OpenNi2Camera::Impl {
 
     Status OpenOnce();
     void CloseStreams();
+    Status SetDepthMode();
+    Result<CameraIntrinsics> Intrinsics(const openni::VideoMode& mode) const;
     Status Recover(int attempt);
     Result<DepthImage> ReadOne(std::chrono::milliseconds timeout);
 };
@@ -141,29 +143,9 @@ Status OpenNi2Camera::Impl::OpenOnce() {
         return e;
     }
     if (!is_file) {
-        const openni::SensorInfo* info = device.getSensorInfo(openni::SENSOR_DEPTH);
-        if (info) {
-            auto mode = ChooseVideoMode(*info, config);
-            if (!mode) {
-                CloseStreams();
-                return CameraError(Where() + ": " + mode.error().message.substr(9));
-            }
-            const openni::VideoMode current = stream.getVideoMode();
-            const bool same = current.getResolutionX() == mode->getResolutionX() &&
-                              current.getResolutionY() == mode->getResolutionY() &&
-                              current.getPixelFormat() == mode->getPixelFormat() &&
-                              current.getFps() == mode->getFps();
-            if (!same && stream.setVideoMode(*mode) != openni::STATUS_OK) {
-                const Error e =
-                    CameraError(Where() + ": cannot set the depth mode: " + LastOpenNiError());
-                CloseStreams();
-                return e;
-            }
-        }
-        // Mirroring would flip x and break the OpenCV camera convention; not every driver has
-        // the property, so a refusal is only logged.
-        if (stream.setMirroringEnabled(false) != openni::STATUS_OK) {
-            spdlog::debug("{}: mirroring cannot be switched off: {}", Where(), LastOpenNiError());
+        if (auto st = SetDepthMode(); !st) {
+            CloseStreams();
+            return st;
         }
     }
     const openni::VideoMode mode = stream.getVideoMode();
@@ -174,13 +156,54 @@ Status OpenNi2Camera::Impl::OpenOnce() {
                            ", not 1 mm or 100 um depth");
     }
     format = mode.getPixelFormat();
+    auto k = Intrinsics(mode);
+    if (!k) {
+        CloseStreams();
+        return k.error();
+    }
+    if (stream.start() != openni::STATUS_OK) {
+        const Error e = CameraError(Where() + ": cannot start depth stream: " + LastOpenNiError());
+        CloseStreams();
+        return e;
+    }
+    intrinsics = *k;
+    open = true;
+    spdlog::info("{}: depth {}x{} {} fx={:.1f} fy={:.1f}", Where(), k->width, k->height,
+                 format == openni::PIXEL_FORMAT_DEPTH_100_UM ? "100um" : "1mm", k->fx, k->fy);
+    return OkStatus();
+}
+
+// The configured depth mode, where the device lists it, and no mirroring: it would flip x and
+// break the OpenCV camera convention; not every driver has the property, so a refusal is only
+// logged.
+Status OpenNi2Camera::Impl::SetDepthMode() {
+    if (const openni::SensorInfo* info = device.getSensorInfo(openni::SENSOR_DEPTH)) {
+        auto mode = ChooseVideoMode(*info, config);
+        if (!mode) return CameraError(Where() + ": " + mode.error().message.substr(9));
+        const openni::VideoMode current = stream.getVideoMode();
+        const bool same = current.getResolutionX() == mode->getResolutionX() &&
+                          current.getResolutionY() == mode->getResolutionY() &&
+                          current.getPixelFormat() == mode->getPixelFormat() &&
+                          current.getFps() == mode->getFps();
+        if (!same && stream.setVideoMode(*mode) != openni::STATUS_OK) {
+            return CameraError(Where() + ": cannot set the depth mode: " + LastOpenNiError());
+        }
+    }
+    if (stream.setMirroringEnabled(false) != openni::STATUS_OK) {
+        spdlog::debug("{}: mirroring cannot be switched off: {}", Where(), LastOpenNiError());
+    }
+    return OkStatus();
+}
+
+// The stream's intrinsics: the config's where it sets them (for the stream's resolution), else
+// from the fields of view the stream reports.
+Result<CameraIntrinsics> OpenNi2Camera::Impl::Intrinsics(const openni::VideoMode& mode) const {
     CameraIntrinsics k;
     k.width = mode.getResolutionX();
     k.height = mode.getResolutionY();
     k.depth_unit_m = depth_unit_m;
     if (override_intrinsics) {
         if (override_intrinsics->width != k.width || override_intrinsics->height != k.height) {
-            CloseStreams();
             return CameraError(Where() + ": camera.intrinsics are for " +
                                std::to_string(override_intrinsics->width) + "x" +
                                std::to_string(override_intrinsics->height) + " but the stream is " +
@@ -194,7 +217,6 @@ Status OpenNi2Camera::Impl::OpenOnce() {
         const double hfov = stream.getHorizontalFieldOfView();
         const double vfov = stream.getVerticalFieldOfView();
         if (!(hfov > 0.0 && hfov < M_PI) || !(vfov > 0.0 && vfov < M_PI)) {
-            CloseStreams();
             return CameraError(Where() +
                                ": the stream reports no field of view; set camera.intrinsics "
                                "(fx, fy, cx, cy) in the config");
@@ -204,20 +226,9 @@ Status OpenNi2Camera::Impl::OpenOnce() {
         k.cx = (k.width - 1) / 2.0;
         k.cy = (k.height - 1) / 2.0;
     }
-    if (auto st = k.Validate("camera"); !st) {
-        CloseStreams();
+    if (auto st = k.Validate("camera"); !st)
         return CameraError(Where() + ": " + st.error().message);
-    }
-    if (stream.start() != openni::STATUS_OK) {
-        const Error e = CameraError(Where() + ": cannot start depth stream: " + LastOpenNiError());
-        CloseStreams();
-        return e;
-    }
-    intrinsics = k;
-    open = true;
-    spdlog::info("{}: depth {}x{} {} fx={:.1f} fy={:.1f}", Where(), k.width, k.height,
-                 format == openni::PIXEL_FORMAT_DEPTH_100_UM ? "100um" : "1mm", k.fx, k.fy);
-    return OkStatus();
+    return k;
 }
 
 void OpenNi2Camera::Impl::CloseStreams() {

@@ -64,6 +64,72 @@ Status ValidateExtraObjects(const std::vector<SyntheticBox>& objects, double dis
     return OkStatus();
 }
 
+// The camera's pose: within its ranges, and looking at the scene from outside (not inside the
+// disc's or the box's reach below the box top, `reach` the box's from the axis).
+Status ValidateCameraPose(const SyntheticCameraPose& cp, double disc_radius_m, double reach,
+                          double box_height_m) {
+    if (!Finite(cp.distance_m) || cp.distance_m <= 0.0 || cp.distance_m > 20.0) {
+        return Bad("camera_pose.distance_m", "must be in (0, 20] metres");
+    }
+    if (!Finite(cp.elevation_deg) || cp.elevation_deg < 5.0 || cp.elevation_deg > 85.0) {
+        return Bad("camera_pose.elevation_deg", "must be in 5..85 degrees");
+    }
+    if (!Finite(cp.aim_height_m) || cp.aim_height_m < 0.0 || cp.aim_height_m > 5.0) {
+        return Bad("camera_pose.aim_height_m", "must be in 0..5 metres");
+    }
+    const double el = cp.elevation_deg * kDegToRad;
+    const double horizontal = cp.distance_m * std::cos(el);
+    const double height = cp.aim_height_m + cp.distance_m * std::sin(el);
+    if (horizontal <= std::max(disc_radius_m, reach) && height <= box_height_m) {
+        return Bad("camera_pose.distance_m", "the camera would be inside the scene");
+    }
+    return OkStatus();
+}
+
+// The station's own errors: the turntable's angles, the calibration's, the depth offset, the
+// focal length.
+Status ValidateStationErrors(const SyntheticStationConfig& c) {
+    if (!Finite(c.angle_error_deg) || c.angle_error_deg < 0.0 || c.angle_error_deg > 10.0) {
+        return Bad("angle_error_deg", "must be in 0..10 degrees");
+    }
+    if (!Finite(c.calib_center_error_m) || c.calib_center_error_m < 0.0 ||
+        c.calib_center_error_m > 0.1) {
+        return Bad("calib_center_error_m", "must be in 0..0.1 metres");
+    }
+    if (!Finite(c.calib_axis_error_deg) || c.calib_axis_error_deg < 0.0 ||
+        c.calib_axis_error_deg > 10.0) {
+        return Bad("calib_axis_error_deg", "must be in 0..10 degrees");
+    }
+    if (!Finite(c.true_depth_offset_m) || std::abs(c.true_depth_offset_m) > 0.5) {
+        return Bad("true_depth_offset_m", "must be within +-0.5 metres");
+    }
+    if (!Finite(c.calib_depth_offset_error_m) ||
+        std::abs(c.true_depth_offset_m + c.calib_depth_offset_error_m) > 0.5) {
+        return Bad("calib_depth_offset_error_m",
+                   "must be finite and keep the recorded offset within +-0.5 metres");
+    }
+    if (!Finite(c.focal_error_pct) || std::abs(c.focal_error_pct) > 10.0) {
+        return Bad("focal_error_pct", "must be a finite number of per cent within +-10");
+    }
+    return OkStatus();
+}
+
+// A box moved between poses: from pose 1 on, by finite amounts, staying on the disc.
+Status ValidateMove(const SyntheticStationConfig& c) {
+    if (!c.moved_at_pose) return OkStatus();
+    if (*c.moved_at_pose < 1) return Bad("moved_at_pose", "must be a pose index >= 1");
+    if (!Finite(c.moved_dx_m)) return Bad("moved_dx_m", "must be finite");
+    if (!Finite(c.moved_dy_m)) return Bad("moved_dy_m", "must be finite");
+    if (!Finite(c.moved_dyaw_deg)) return Bad("moved_dyaw_deg", "must be finite");
+    const double moved_reach =
+        SyntheticObjectReach(c.box, c.moved_dx_m, c.moved_dy_m, c.moved_dyaw_deg);
+    if (moved_reach > c.disc_radius_m) {
+        return Bad("moved_dx_m", "the moved box would reach " + std::to_string(moved_reach) +
+                                     " m from the axis, beyond the disc");
+    }
+    return OkStatus();
+}
+
 }  // namespace
 
 Status SyntheticStationConfig::Validate() const {
@@ -90,62 +156,14 @@ Status SyntheticStationConfig::Validate() const {
                               " m from the axis, beyond the disc radius " +
                               std::to_string(disc_radius_m) + " m (check dims and offset)");
     }
-    const SyntheticCameraPose& cp = camera_pose;
-    if (!Finite(cp.distance_m) || cp.distance_m <= 0.0 || cp.distance_m > 20.0) {
-        return Bad("camera_pose.distance_m", "must be in (0, 20] metres");
-    }
-    if (!Finite(cp.elevation_deg) || cp.elevation_deg < 5.0 || cp.elevation_deg > 85.0) {
-        return Bad("camera_pose.elevation_deg", "must be in 5..85 degrees");
-    }
-    if (!Finite(cp.aim_height_m) || cp.aim_height_m < 0.0 || cp.aim_height_m > 5.0) {
-        return Bad("camera_pose.aim_height_m", "must be in 0..5 metres");
-    }
-    {
-        // The camera must look at the scene from outside: not inside the disc's or the box's
-        // reach below the box top.
-        const double el = cp.elevation_deg * kDegToRad;
-        const double horizontal = cp.distance_m * std::cos(el);
-        const double height = cp.aim_height_m + cp.distance_m * std::sin(el);
-        if (horizontal <= std::max(disc_radius_m, reach) && height <= b.height_m) {
-            return Bad("camera_pose.distance_m", "the camera would be inside the scene");
-        }
+    if (auto st = ValidateCameraPose(camera_pose, disc_radius_m, reach, b.height_m); !st) {
+        return st;
     }
     if (sensor_noise) {
         if (auto st = sensor_noise->Validate("sensor_noise"); !st) return st;
     }
-    if (!Finite(angle_error_deg) || angle_error_deg < 0.0 || angle_error_deg > 10.0) {
-        return Bad("angle_error_deg", "must be in 0..10 degrees");
-    }
-    if (!Finite(calib_center_error_m) || calib_center_error_m < 0.0 || calib_center_error_m > 0.1) {
-        return Bad("calib_center_error_m", "must be in 0..0.1 metres");
-    }
-    if (!Finite(calib_axis_error_deg) || calib_axis_error_deg < 0.0 ||
-        calib_axis_error_deg > 10.0) {
-        return Bad("calib_axis_error_deg", "must be in 0..10 degrees");
-    }
-    if (!Finite(true_depth_offset_m) || std::abs(true_depth_offset_m) > 0.5) {
-        return Bad("true_depth_offset_m", "must be within +-0.5 metres");
-    }
-    if (!Finite(calib_depth_offset_error_m) ||
-        std::abs(true_depth_offset_m + calib_depth_offset_error_m) > 0.5) {
-        return Bad("calib_depth_offset_error_m",
-                   "must be finite and keep the recorded offset within +-0.5 metres");
-    }
-    if (!Finite(focal_error_pct) || std::abs(focal_error_pct) > 10.0) {
-        return Bad("focal_error_pct", "must be a finite number of per cent within +-10");
-    }
-    if (moved_at_pose) {
-        if (*moved_at_pose < 1) return Bad("moved_at_pose", "must be a pose index >= 1");
-        if (!Finite(moved_dx_m)) return Bad("moved_dx_m", "must be finite");
-        if (!Finite(moved_dy_m)) return Bad("moved_dy_m", "must be finite");
-        if (!Finite(moved_dyaw_deg)) return Bad("moved_dyaw_deg", "must be finite");
-        const double moved_reach = SyntheticObjectReach(b, moved_dx_m, moved_dy_m, moved_dyaw_deg);
-        if (moved_reach > disc_radius_m) {
-            return Bad("moved_dx_m", "the moved box would reach " + std::to_string(moved_reach) +
-                                         " m from the axis, beyond the disc");
-        }
-    }
-    return OkStatus();
+    if (auto st = ValidateStationErrors(*this); !st) return st;
+    return ValidateMove(*this);
 }
 
 std::uint64_t SyntheticFrameSeed(std::uint64_t seed, int pose, int frame) {

@@ -1,6 +1,8 @@
 #include "pipeline/envelope/face_envelope.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>
@@ -54,67 +56,97 @@ struct FaceCells {
         double se;
     };
 
-    FaceResult Evaluate(const EnvelopeConfig& config, double point_sigma) const {
-        // Each cell's mean over its views' means, and the views' spread pooled over the face.
-        // The fused cloud keeps a pixel in nine, so a view holds a handful of readings in a
-        // cell, often one or two where it sees the face obliquely: every view that read the
-        // cell is a sample (the pooled spread is the spread of such samples), or a face's
-        // middle, where a bulge crests, would go unjudged.
+    // The face's cells, each a mean over its views' means, and the views' spread pooled over the
+    // face. The fused cloud keeps a pixel in nine, so a view holds a handful of readings in a
+    // cell, often one or two where it sees the face obliquely: every view that read the cell is
+    // a sample (the pooled spread is the spread of such samples), or a face's middle, where a
+    // bulge crests, would go unjudged.
+    struct Pool {
         std::unordered_map<std::size_t, CellStats> cells;
         std::unordered_map<std::size_t, double> inverse_counts;  // per cell: Σ 1/r over views
+        int dof = 0, total = 0, within_dof = 0;
+        double spread = 0.0, noise = 0.0, shared = 0.0;
+        bool Pooled() const { return dof >= 10; }
+    };
+
+    Pool PoolViews(double point_sigma) const {
+        Pool p;
         for (const auto& [key, st] : cell_view) {
             const std::size_t cell = key / static_cast<std::size_t>(views);
-            cells[cell].Add(st.Mean());
-            inverse_counts[cell] += 1.0 / st.n;
+            p.cells[cell].Add(st.Mean());
+            p.inverse_counts[cell] += 1.0 / st.n;
         }
         double pooled = 0.0, within = 0.0, inverse_sum = 0.0;
-        int dof = 0, total = 0, within_dof = 0, samples = 0;
-        for (const auto& [cell, st] : cells) {
-            if (st.n >= 2) {
-                pooled += st.sum_sq - st.sum * st.sum / st.n;
-                dof += st.n - 1;
-                inverse_sum += inverse_counts.at(cell);
-                samples += st.n;
-            }
+        int samples = 0;
+        for (const auto& [cell, st] : p.cells) {
+            if (st.n < 2) continue;
+            pooled += st.sum_sq - st.sum * st.sum / st.n;
+            p.dof += st.n - 1;
+            inverse_sum += p.inverse_counts.at(cell);
+            samples += st.n;
         }
         for (const auto& [key, st] : cell_view) {
-            total += st.n;
-            if (st.n >= 2) {
-                within += st.sum_sq - st.sum * st.sum / st.n;
-                within_dof += st.n - 1;
-            }
+            p.total += st.n;
+            if (st.n < 2) continue;
+            within += st.sum_sq - st.sum * st.sum / st.n;
+            p.within_dof += st.n - 1;
         }
         // Without a second view of any cell (one pose), the within-view noise of a cell's mean,
         // its readings counted as a tenth as many independent ones.
-        const double spread = dof >= 10 ? std::sqrt(pooled / dof) : point_sigma;
+        p.spread = p.Pooled() ? std::sqrt(pooled / p.dof) : point_sigma;
         // A view's mean of a cell errs by what the view shares over the face (its registration,
         // its plane) and by its readings' noise over their count r: var = shared + noise / r.
         // The pooled spread mixes views of many readings with views of one or two; a cell whose
         // views read it with fewer than the face's usual count is known worse than the spread
         // says, one read with more better. Both parts from the face: the readings' scatter
         // within a view's cell, and what of the spread that leaves.
-        const double noise = within_dof >= 10 ? within / within_dof : 0.0;
-        const double shared =
-            samples > 0 ? std::max(0.0, spread * spread - noise * inverse_sum / samples) : 0.0;
+        p.noise = p.within_dof >= 10 ? within / p.within_dof : 0.0;
+        p.shared = samples > 0
+                       ? std::max(0.0, p.spread * p.spread - p.noise * inverse_sum / samples)
+                       : 0.0;
+        return p;
+    }
+
+    // The cells judged for standing out, each with its standard error. A cell is judged from
+    // three views on (its own scatter then has two degrees of freedom to check the modelled
+    // error against); see kCellViews for which reading takes which. A cell whose views scatter
+    // more than the face's do (an edge some views see at grazing incidence, where the lateral
+    // noise throws readings off the face) is known no better than its own scatter says.
+    static std::vector<Judged> Judge(const Pool& p) {
         std::vector<Judged> judged;
-        for (const auto& [cell, st] : cells) {
-            // A cell is judged from three views on (its own scatter then has two degrees of
-            // freedom to check the modelled error against); see kCellViews for which reading
-            // takes which.
-            if (st.n < kBowCellViews && dof >= 10) continue;
-            // A cell whose views scatter more than the face's do (an edge some views see at
-            // grazing incidence, where the lateral noise throws readings off the face) is
-            // known no better than its own scatter says.
+        for (const auto& [cell, st] : p.cells) {
+            if (st.n < kBowCellViews && p.Pooled()) continue;
             const double own = st.n >= 2 ? st.StdError() : 0.0;
             const double modelled =
-                within_dof >= 10
-                    ? std::sqrt(shared / st.n + noise * inverse_counts.at(cell) / (st.n * st.n))
-                    : spread / std::sqrt(st.n);
-            judged.push_back(
-                {cell, st,
-                 dof >= 10 ? std::max(modelled, own)
-                           : spread / std::sqrt(std::max(1.0, total / 10.0 / cells.size()))});
+                p.within_dof >= 10 ? std::sqrt(p.shared / st.n +
+                                               p.noise * p.inverse_counts.at(cell) / (st.n * st.n))
+                                   : p.spread / std::sqrt(st.n);
+            const double single =
+                p.spread / std::sqrt(std::max(1.0, p.total / 10.0 / p.cells.size()));
+            judged.push_back({cell, st, p.Pooled() ? std::max(modelled, own) : single});
         }
+        return judged;
+    }
+
+    // Flatness: the cells seen by two views or more, their means about the plane against their
+    // own standard errors (chi-square per cell: about 1 for a flat face); NaN when too few.
+    static double Flatness(const Pool& p) {
+        if (!p.Pooled()) return std::numeric_limits<double>::quiet_NaN();
+        double chi2 = 0.0;
+        int tested = 0;
+        for (const auto& [cell, st] : p.cells) {
+            if (st.n < 2) continue;
+            const double r = st.Mean() / (p.spread / std::sqrt(st.n));
+            chi2 += r * r;
+            ++tested;
+        }
+        return tested >= kMinFlatnessCells ? chi2 / tested
+                                           : std::numeric_limits<double>::quiet_NaN();
+    }
+
+    FaceResult Evaluate(const EnvelopeConfig& config, double point_sigma) const {
+        const Pool pool = PoolViews(point_sigma);
+        const std::vector<Judged> judged = Judge(pool);
         // The plane's offset as each view sees it: their spread is the registration's and the
         // noise's contribution to the face's position.
         CellStats offsets;
@@ -122,31 +154,26 @@ struct FaceCells {
             if (v.n >= 4 * config.min_cell_points) offsets.Add(v.Mean());
         }
         FaceResult out;
-        // Flatness: the cells seen by two views or more, their means about the plane against
-        // their own standard errors (chi-square per cell: about 1 for a flat face).
-        if (dof >= 10) {
-            double chi2 = 0.0;
-            int tested = 0;
-            for (const auto& [cell, st] : cells) {
-                if (st.n < 2) continue;
-                const double r = st.Mean() / (spread / std::sqrt(st.n));
-                chi2 += r * r;
-                ++tested;
-            }
-            if (tested >= kMinFlatnessCells) out.flatness = chi2 / tested;
-        }
+        if (const double flat = Flatness(pool); !std::isnan(flat)) out.flatness = flat;
         out.view_spread_m = offsets.n >= 2 ? offsets.StdError() * std::sqrt(offsets.n) : 0.0;
         // The views' own scatter, without CellStats' floor (a face's offset is the mean of
         // thousands of readings per view), widened for the few views it is estimated from.
         out.offset_se_m =
             offsets.n >= 2 ? WidenedForSamples(std::sqrt(offsets.Variance() / offsets.n), offsets.n)
-                           : spread / std::sqrt(std::max<std::size_t>(1, cells.size()));
+                           : pool.spread / std::sqrt(std::max<std::size_t>(1, pool.cells.size()));
         std::vector<Judged> many;  // the cells seen by kCellViews views or more
         for (const Judged& c : judged) {
-            if (c.st.n >= kCellViews || dof < 10) many.push_back(c);
+            if (c.st.n >= kCellViews || !pool.Pooled()) many.push_back(c);
         }
         ReadExcess(many, config, out.view_spread_m, &out);
-        // A panel bowing out smoothly shows as a whole face (bowed_face.h).
+        ReadBow(judged, config, &out);
+        if (pool.Pooled()) ReadPatches(many, pool.shared, config, &out);
+        return out;
+    }
+
+    // A panel bowing out smoothly shows as a whole face (bowed_face.h).
+    void ReadBow(const std::vector<Judged>& judged, const EnvelopeConfig& config,
+                 FaceResult* out) const {
         std::vector<FaceCell> face;
         face.reserve(judged.size());
         for (const Judged& c : judged) {
@@ -154,13 +181,11 @@ struct FaceCells {
             const auto row = static_cast<double>(c.key / static_cast<std::size_t>(na));
             face.push_back({col * da, row * db, c.st.Mean(), c.se});
         }
-        const auto bow = BowedFaceReach(face, config.false_alarm, out.view_spread_m);
-        if (bow && bow->excess_m > out.excess_m) {
-            out.excess_m = bow->excess_m;
-            out.excess_se_m = bow->se_m;
+        const auto bow = BowedFaceReach(face, config.false_alarm, out->view_spread_m);
+        if (bow && bow->excess_m > out->excess_m) {
+            out->excess_m = bow->excess_m;
+            out->excess_se_m = bow->se_m;
         }
-        if (dof >= 10) ReadPatches(many, shared, config, &out);
-        return out;
     }
 
     // A band or a patch wider than a cell (face_windows.h), where the views' spread is known:

@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 
 #include "pipeline/envelope/cap_reach.h"
 
@@ -83,72 +84,105 @@ double HighEndSe(double variance, double spread_variance, int n) {
 
 double MedianOfLargest(int m) { return UpperNormalQuantile(1.0 - std::pow(0.5, 1.0 / m)); }
 
+namespace {
+
+// A reach, the uncertainty its reading adds to the mean's (`extra_se`), and how far noise alone
+// moves it (`noise_se`: the mean's standard error, and a wall end's high-end reading, HighEndSe,
+// which wanders from cell to cell as the readings fall).
+struct Reach {
+    double value = -INFINITY, extra_se = 0.0, noise_se = 0.0;
+    bool facing = false;
+};
+
+// What a cell's reach is read against: the facing surface's noise, the layer's depth, the walls'
+// own noise along the direction, the cells' extent, and whether walls are read at their high end.
+struct ReachModel {
+    double noise_sigma, layer, wall_var, cell_extent_m;
+    bool walls;
+};
+
+// A cell's outer layer is one of three things; its own 3-D scatter says which.
+//  - A surface facing the direction (its normal within 60 degrees of it): the mean is the
+//    surface. Tilted by θ, it spreads over the cell's extent e by e·tan θ (at most the
+//    layer's depth), and its high end lies somewhere in that spread above the mean (a
+//    panel opened at 30 or 60 degrees): the uncertainty carries the spread's standard
+//    deviation, spread / √12. A cell its caller marks with `high_end_above_mean_m` (a
+//    sloped patch that continues downhill, support_envelope.cpp) is read at that high end
+//    instead: spread evenly over the cell, its readings reach √3 standard deviations of
+//    their plane's rise above their mean; one marked with `cap_above_mean_m` (the top of
+//    a smooth cap) that far above its mean, uncertain by as much. (At any looser limit
+//    than 60 degrees, two faces meeting in a cell pass for one tilted surface and widen
+//    flat boxes by millimetres.)
+//  - One surface crossing the layer — a wall running along the direction, a steep panel,
+//    a tube's flank: its readings lie on one plane (their variance off
+//    it is the noise's) and spread evenly over the layer, so its high end lies √3 standard
+//    deviations of that spread beyond the noise above their mean, as well as that
+//    spread's sample variance tells (HighEndSe). The noise taken off their variance is
+//    their own along the direction judged (`wall_noise_sigma`), not the facing surface's.
+//  - Two surfaces sharing the cell (a corner: a face and the end of the next one): neither
+//    model holds. The mean is the safe reach, and the uncertainty carries the layer.
+// A variance must exceed the noise's by three of its standard errors to count
+// (SampleVarianceSe).
+Reach CellReach(const LayerCell& c, const ReachModel& model) {
+    const double noise_var = model.noise_sigma * model.noise_sigma;
+    double off_plane = 0.0;
+    const double cos_t = std::min(1.0, c.Facing(&off_plane));
+    const double var = c.Variance();
+    const double wander = 3.0 * SampleVarianceSe(noise_var, c.n);
+    if (cos_t >= 0.5) {
+        const double spread =
+            std::min(model.cell_extent_m * std::sqrt(1.0 - cos_t * cos_t) / cos_t, model.layer);
+        const double se_spread = spread > model.noise_sigma ? spread / std::sqrt(12.0) : 0.0;
+        return {c.Mean() + c.high_end_above_mean_m + c.cap_above_mean_m,
+                std::hypot(se_spread, c.cap_above_mean_m), c.StdError(), true};
+    }
+    const double wall_var = model.wall_var;
+    if (!model.walls || var - wall_var <= 3.0 * SampleVarianceSe(wall_var, c.n)) {
+        return {c.Mean(), 0.0, c.StdError()};
+    }
+    if (off_plane > noise_var + wander)
+        return {c.Mean(), model.layer / std::sqrt(12.0), c.StdError()};
+    const double high_end_se = HighEndSe(var, var - wall_var, c.n);
+    return {c.Mean() + std::sqrt(3.0 * (var - wall_var)), high_end_se,
+            std::hypot(c.StdError(), high_end_se)};
+}
+
+// A smooth cap's crest: its cells fall away from it, and a quadratic fitted over the facing cells
+// round the chosen one reads it (cap_reach.h) where the correction for the largest of several
+// takes them for equals. Replaces `best` and widens `se` where it can be fitted.
+void ReadCapCrest(const std::vector<LayerCell>& cells, const std::vector<Reach>& reaches,
+                  std::size_t chosen, int min_cell_points, double cell_extent_m, double* best,
+                  double* se) {
+    const Eigen::Vector2d at = cells[chosen].Centroid().head<2>();
+    std::vector<std::size_t> near{chosen};
+    std::vector<double> cell_se(cells.size(), 0.0);
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+        if (cells[k].n < min_cell_points || !reaches[k].facing) continue;
+        cell_se[k] = cells[k].StdError();
+        const Eigen::Vector2d p = cells[k].Centroid().head<2>();
+        if (k != chosen && (p - at).norm() <= kCapRadiusCells * cell_extent_m) near.push_back(k);
+    }
+    if (const auto cap = FitCapReach(cells, cell_se, near)) {
+        *best = cap->value;
+        *se = std::max(*se, cap->se);
+    }
+}
+
+}  // namespace
+
 double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
                     double noise_sigma, double wall_noise_sigma, double cell_extent_m, double* se,
                     int* judged, bool walls, bool caps) {
-    // A cell's outer layer is one of three things; its own 3-D scatter says which.
-    //  - A surface facing the direction (its normal within 60 degrees of it): the mean is the
-    //    surface. Tilted by θ, it spreads over the cell's extent e by e·tan θ (at most the
-    //    layer's depth), and its high end lies somewhere in that spread above the mean (a
-    //    panel opened at 30 or 60 degrees): the uncertainty carries the spread's standard
-    //    deviation, spread / √12. A cell its caller marks with `high_end_above_mean_m` (a
-    //    sloped patch that continues downhill, support_envelope.cpp) is read at that high end
-    //    instead: spread evenly over the cell, its readings reach √3 standard deviations of
-    //    their plane's rise above their mean; one marked with `cap_above_mean_m` (the top of
-    //    a smooth cap) that far above its mean, uncertain by as much. (At any looser limit
-    //    than 60 degrees, two faces meeting in a cell pass for one tilted surface and widen
-    //    flat boxes by millimetres.)
-    //  - One surface crossing the layer — a wall running along the direction, a steep panel,
-    //    a tube's flank: its readings lie on one plane (their variance off
-    //    it is the noise's) and spread evenly over the layer, so its high end lies √3 standard
-    //    deviations of that spread beyond the noise above their mean, as well as that
-    //    spread's sample variance tells (HighEndSe). The noise taken off their variance is
-    //    their own along the direction judged (`wall_noise_sigma`), not the facing surface's.
-    //  - Two surfaces sharing the cell (a corner: a face and the end of the next one): neither
-    //    model holds. The mean is the safe reach, and the uncertainty carries the layer.
-    // A variance must exceed the noise's by three of its standard errors to count
-    // (SampleVarianceSe).
-    const double layer = config.layer_sigmas * noise_sigma;
-    const double noise_var = noise_sigma * noise_sigma;
-    const double wall_var = wall_noise_sigma * wall_noise_sigma;
-    // A reach, the uncertainty its reading adds to the mean's (`extra_se`), and how far noise
-    // alone moves it (`noise_se`: the mean's standard error, and a wall end's high-end reading,
-    // HighEndSe, which wanders from cell to cell as the readings fall).
-    struct Reach {
-        double value, extra_se, noise_se;
-        bool facing = false;
-    };
-    auto reach_of = [&](const LayerCell& c) -> Reach {
-        double off_plane = 0.0;
-        const double cos_t = std::min(1.0, c.Facing(&off_plane));
-        const double var = c.Variance();
-        const double wander = 3.0 * SampleVarianceSe(noise_var, c.n);
-        if (cos_t >= 0.5) {
-            const double spread =
-                std::min(cell_extent_m * std::sqrt(1.0 - cos_t * cos_t) / cos_t, layer);
-            const double se_spread = spread > noise_sigma ? spread / std::sqrt(12.0) : 0.0;
-            return {c.Mean() + c.high_end_above_mean_m + c.cap_above_mean_m,
-                    std::hypot(se_spread, c.cap_above_mean_m), c.StdError(), true};
-        }
-        if (!walls || var - wall_var <= 3.0 * SampleVarianceSe(wall_var, c.n)) {
-            return {c.Mean(), 0.0, c.StdError()};
-        }
-        if (off_plane > noise_var + wander) {
-            return {c.Mean(), layer / std::sqrt(12.0), c.StdError()};
-        }
-        const double high_end_se = HighEndSe(var, var - wall_var, c.n);
-        return {c.Mean() + std::sqrt(3.0 * (var - wall_var)), high_end_se,
-                std::hypot(c.StdError(), high_end_se)};
-    };
+    const ReachModel model{noise_sigma, config.layer_sigmas * noise_sigma,
+                           wall_noise_sigma * wall_noise_sigma, cell_extent_m, walls};
     // Each judged cell's reach, once: it costs an eigen-decomposition of the cell's scatter.
-    std::vector<Reach> reaches(cells.size(), Reach{-INFINITY, 0.0, 0.0, false});
+    std::vector<Reach> reaches(cells.size());
     int m = 0;
     double top = -INFINITY, top_se = 0.0;
     for (std::size_t k = 0; k < cells.size(); ++k) {
-        const LayerCell& c = cells[k];
-        if (c.n < config.min_cell_points) continue;
+        if (cells[k].n < config.min_cell_points) continue;
         ++m;
-        reaches[k] = reach_of(c);
+        reaches[k] = CellReach(cells[k], model);
         if (reaches[k].value > top) {
             top = reaches[k].value;
             top_se = reaches[k].noise_se;
@@ -174,25 +208,8 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
             *se = std::hypot(cells[k].StdError(), reaches[k].extra_se);
         }
     }
-    // A smooth cap's crest: its cells fall away from it, and a quadratic fitted over the facing
-    // cells round the chosen one reads it (cap_reach.h) where the correction above would take
-    // them for equals.
     if (caps && reaches[chosen].facing && contenders > 1) {
-        const Eigen::Vector2d at = cells[chosen].Centroid().head<2>();
-        std::vector<std::size_t> near{chosen};
-        std::vector<double> cell_se(cells.size(), 0.0);
-        for (std::size_t k = 0; k < cells.size(); ++k) {
-            if (cells[k].n < config.min_cell_points || !reaches[k].facing) continue;
-            cell_se[k] = cells[k].StdError();
-            const Eigen::Vector2d p = cells[k].Centroid().head<2>();
-            if (k != chosen && (p - at).norm() <= kCapRadiusCells * cell_extent_m) {
-                near.push_back(k);
-            }
-        }
-        if (const auto cap = FitCapReach(cells, cell_se, near)) {
-            best = cap->value;
-            *se = std::max(*se, cap->se);
-        }
+        ReadCapCrest(cells, reaches, chosen, config.min_cell_points, cell_extent_m, &best, se);
     }
     return best;
 }

@@ -50,15 +50,18 @@ Eigen::Vector2d FaceNormal(double yaw, int face) {
     return {std::cos(a), std::sin(a)};
 }
 
-bool FitSides(const Points& points, const BoxFitConfig& config, const ReadingRays* rays,
-              double margin, const std::array<double, 4>& band, BoxState& s,
-              std::array<int, 5>& counts) {
+namespace {
+
+// The readings each side's fit takes: within the side's band of its plane, clear of its edges by
+// the margin (judged along each reading's ray where the rays are known, face_choice.h).
+std::vector<FacePoint> SideReadings(const Points& points, const BoxFitConfig& config,
+                                    const ReadingRays* rays, double margin,
+                                    const std::array<double, 4>& band, const BoxState& s) {
     const FaceFrame frame(s);
     const auto& n = frame.n;
-    const double half_u = frame.half_u, half_v = frame.half_v, cu = frame.cu, cv = frame.cv;
     const FaceChoice choice(rays, margin);
     const double m = choice.margin(), gate = choice.gate();
-    const std::vector<FacePoint> sel = ParallelCollect<FacePoint>(
+    return ParallelCollect<FacePoint>(
         points.size(), config.threads,
         [&](std::size_t begin, std::size_t end, std::vector<FacePoint>& out) {
             for (std::size_t i = begin; i < end; ++i) {
@@ -70,7 +73,8 @@ bool FitSides(const Points& points, const BoxFitConfig& config, const ReadingRay
                     const double r = n[k].dot(p) - s.d[k];
                     if (std::abs(r) > band[k]) continue;
                     const Eigen::Vector2d& across = f < 2 ? n[2] : n[0];
-                    const double mid = f < 2 ? cv : cu, half = f < 2 ? half_v : half_u;
+                    const double mid = f < 2 ? frame.cv : frame.cu;
+                    const double half = f < 2 ? frame.half_v : frame.half_u;
                     if (std::abs(across.dot(p) - mid) > half - gate) continue;
                     const auto x =
                         choice.Judged(i, p3, Eigen::Vector3d(n[k].x(), n[k].y(), 0.0), s.d[k]);
@@ -82,33 +86,48 @@ bool FitSides(const Points& points, const BoxFitConfig& config, const ReadingRay
                 }
             }
         });
-    auto solve = [&](const std::vector<char>& use, std::array<int, 5>& cnt) {
-        // Unknowns: dyaw, dd0..dd3. r + (n'·p) dyaw - dd_f = 0.
-        Eigen::Matrix<double, 5, 5> h = Eigen::Matrix<double, 5, 5>::Zero();
-        Eigen::Matrix<double, 5, 1> g = Eigen::Matrix<double, 5, 1>::Zero();
-        cnt.fill(0);
-        for (std::size_t i = 0; i < sel.size(); ++i) {
-            if (!use[i]) continue;
-            const auto k = static_cast<std::size_t>(sel[i].face);
-            const Eigen::Vector2d nd(-n[k].y(), n[k].x());
-            const double r = n[k].dot(sel[i].xy) - s.d[k];
-            // The Jacobian row has two entries, j0 and -1 at 1 + k: only the terms they touch
-            // (h is symmetric; its lower triangle is all ldlt reads).
-            const double j0 = nd.dot(sel[i].xy);
-            const long f = 1 + static_cast<long>(k);
-            h(0, 0) += j0 * j0;
-            h(f, 0) -= j0;
-            h(f, f) += 1.0;
-            g(0) += j0 * r;
-            g(f) -= r;
-            ++cnt[k];
-        }
-        h.diagonal().array() += 1e-12;
-        return Eigen::Matrix<double, 5, 1>(h.ldlt().solve(-g));
-    };
+}
+
+// One Gauss-Newton step of the sides over the readings `use` marks (their count per side into
+// `cnt`). Unknowns: dyaw, dd0..dd3; a reading's residual r + (n'·p) dyaw - dd_f = 0.
+Eigen::Matrix<double, 5, 1> SolveSides(const std::vector<FacePoint>& sel,
+                                       const std::vector<char>& use, const FaceFrame& frame,
+                                       const BoxState& s, std::array<int, 5>& cnt) {
+    const auto& n = frame.n;
+    Eigen::Matrix<double, 5, 5> h = Eigen::Matrix<double, 5, 5>::Zero();
+    Eigen::Matrix<double, 5, 1> g = Eigen::Matrix<double, 5, 1>::Zero();
+    cnt.fill(0);
+    for (std::size_t i = 0; i < sel.size(); ++i) {
+        if (!use[i]) continue;
+        const auto k = static_cast<std::size_t>(sel[i].face);
+        const Eigen::Vector2d nd(-n[k].y(), n[k].x());
+        const double r = n[k].dot(sel[i].xy) - s.d[k];
+        // The Jacobian row has two entries, j0 and -1 at 1 + k: only the terms they touch (h is
+        // symmetric; its lower triangle is all ldlt reads).
+        const double j0 = nd.dot(sel[i].xy);
+        const long f = 1 + static_cast<long>(k);
+        h(0, 0) += j0 * j0;
+        h(f, 0) -= j0;
+        h(f, f) += 1.0;
+        g(0) += j0 * r;
+        g(f) -= r;
+        ++cnt[k];
+    }
+    h.diagonal().array() += 1e-12;
+    return Eigen::Matrix<double, 5, 1>(h.ldlt().solve(-g));
+}
+
+}  // namespace
+
+bool FitSides(const Points& points, const BoxFitConfig& config, const ReadingRays* rays,
+              double margin, const std::array<double, 4>& band, BoxState& s,
+              std::array<int, 5>& counts) {
+    const FaceFrame frame(s);
+    const auto& n = frame.n;
+    const std::vector<FacePoint> sel = SideReadings(points, config, rays, margin, band, s);
     std::vector<char> use(sel.size(), 1);
     std::array<int, 5> cnt{};
-    Eigen::Matrix<double, 5, 1> delta = solve(use, cnt);
+    Eigen::Matrix<double, 5, 1> delta = SolveSides(sel, use, frame, s, cnt);
     // Trim per face with the robust sigma of the residuals after the first solve.
     std::array<std::vector<double>, 4> res;
     std::vector<double> r_all(sel.size());
@@ -128,7 +147,7 @@ bool FitSides(const Points& points, const BoxFitConfig& config, const ReadingRay
         const auto k = static_cast<std::size_t>(sel[i].face);
         use[i] = std::abs(r_all[i]) <= config.trim_sigmas * sig[k];
     }
-    delta = solve(use, cnt);
+    delta = SolveSides(sel, use, frame, s, cnt);
     for (std::size_t k = 0; k < 4; ++k) {
         counts[k] = cnt[k];
         s.sigma[k] = sig[k];

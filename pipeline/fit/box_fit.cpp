@@ -107,84 +107,60 @@ Result<BoxFit> FitFootprintBox(const Points& points, const BoxFitConfig& config)
     return FitFootprintBox(points, points, config);
 }
 
-Result<BoxFit> FitFootprintBox(const Points& seed_points, const Points& points,
-                               const BoxFitConfig& config, const ReadingRays& rays) {
-    const ReadingRays* by_ray = rays.Covers(points.size()) ? &rays : nullptr;
-    if (seed_points.size() < 10 || points.size() < 10) {
-        return Error{ErrorCode::kObjectTooSmall, "too few object points"};
-    }
-    auto seeded = SeedFootprint(seed_points, config);
-    if (!seeded) return seeded.error();
-    BoxState s = *seeded;
-    {
-        std::vector<float> z(seed_points.size());
-        for (std::size_t i = 0; i < seed_points.size(); ++i) z[i] = seed_points[i].z();
-        const auto q =
-            static_cast<long>(config.seed_top_quantile * static_cast<double>(z.size() - 1));
-        std::nth_element(z.begin(), z.begin() + q, z.end());
-        s.height = z[static_cast<std::size_t>(q)];
-    }
-    const double min_side = std::min(s.d[0] + s.d[1], s.d[2] + s.d[3]);
-    const double margin = EdgeMargin(config.edge_margin_m, std::min(min_side, s.height));
-    double rounded_margin = 0.0;
-    if (min_side < 2.0 * margin + 0.01 || s.height < 2.0 * margin + 0.005) {
-        return Error{ErrorCode::kObjectTooSmall, "the object is too small to measure"};
-    }
-    std::array<double, 4> band;
-    band.fill(config.initial_band_m);
-    double top_band = config.initial_band_m;
+namespace {
+
+// The faces' fit as it iterates: the box, each face's band (sides, then the top's), the readings
+// each face kept, and whether the top is read.
+struct FaceFit {
+    BoxState s;
+    std::array<double, 4> band{};
+    double top_band = 0.0;
     std::array<int, 5> counts{};
-    // A top seen only at grazing incidence (a tall box, a camera little above it) has too few
-    // readings to fit: the sides are fitted all the same, at the height of the highest readings,
-    // and the height is left to the enclosing cuboid (where the side faces end).
     bool top_observed = true;
-    for (int it = 0; it < config.iterations; ++it) {
-        if (top_observed && !FitTop(points, config, by_ray, margin, top_band, s, counts)) {
-            top_observed = false;
-        }
-        if (!FitSides(points, config, by_ray, margin, band, s, counts)) {
-            return Error{ErrorCode::kInsufficientData,
-                         "a side face of the object is not observed well enough"};
-        }
-        for (std::size_t k = 0; k < 4; ++k) {
-            band[k] = std::clamp(config.band_sigmas * s.sigma[k], config.min_band_m,
-                                 config.initial_band_m);
-        }
-        top_band =
-            std::clamp(config.band_sigmas * s.sigma[4], config.min_band_m, config.initial_band_m);
-    }
-    if (top_observed && !FitTop(points, config, by_ray, margin, top_band, s, counts)) {
-        top_observed = false;
-    }
-    // Rounded edges reaching farther in than the margin: fitted again clear of them.
-    const double smallest = std::min({s.d[0] + s.d[1], s.d[2] + s.d[3], s.height});
+};
+
+// The height of the `quantile` of the seed's readings.
+double SeedHeight(const Points& seed_points, double quantile) {
+    std::vector<float> z(seed_points.size());
+    for (std::size_t i = 0; i < seed_points.size(); ++i) z[i] = seed_points[i].z();
+    const auto q = static_cast<long>(quantile * static_cast<double>(z.size() - 1));
+    std::nth_element(z.begin(), z.begin() + q, z.end());
+    return z[static_cast<std::size_t>(q)];
+}
+
+// Rounded edges reaching farther in than the margin: the faces fitted again clear of them (two
+// passes). Returns the margin they were fitted with, 0 where the edges do not round off farther
+// or the refit fails (the fit then stays as it was).
+double RefitClearOfRounding(const Points& points, const BoxFitConfig& config,
+                            const ReadingRays* by_ray, double margin, FaceFit& f) {
+    const double smallest = std::min({f.s.d[0] + f.s.d[1], f.s.d[2] + f.s.d[3], f.s.height});
     const double rounded = RoundedEdgeMargin(
-        EdgeSamples(points, config, by_ray, margin, band, top_band, top_observed, s), margin,
-        0.25 * smallest);
-    if (rounded > margin) {
-        spdlog::debug("box fit: the faces round off; margin {:.1f} -> {:.1f} mm", margin * 1e3,
-                      rounded * 1e3);
-        const BoxState before = s;
-        const std::array<int, 5> counts_before = counts;
-        bool refitted = true;
-        for (int it = 0; it < 2 && refitted; ++it) {
-            if (top_observed && !FitTop(points, config, by_ray, rounded, top_band, s, counts)) {
-                refitted = false;
-            }
-            if (refitted && !FitSides(points, config, by_ray, rounded, band, s, counts)) {
-                refitted = false;
-            }
+        EdgeSamples(points, config, by_ray, margin, f.band, f.top_band, f.top_observed, f.s),
+        margin, 0.25 * smallest);
+    if (rounded <= margin) return 0.0;
+    spdlog::debug("box fit: the faces round off; margin {:.1f} -> {:.1f} mm", margin * 1e3,
+                  rounded * 1e3);
+    const FaceFit before = f;
+    bool refitted = true;
+    for (int it = 0; it < 2 && refitted; ++it) {
+        if (f.top_observed && !FitTop(points, config, by_ray, rounded, f.top_band, f.s, f.counts)) {
+            refitted = false;
         }
-        if (refitted) {
-            rounded_margin = rounded;
-        } else {
-            s = before;
-            counts = counts_before;
+        if (refitted && !FitSides(points, config, by_ray, rounded, f.band, f.s, f.counts)) {
+            refitted = false;
         }
     }
+    if (refitted) return rounded;
+    f = before;
+    return 0.0;
+}
+
+// The box of the fitted faces.
+BoxFit BoxOf(const FaceFit& f, double rounded_margin) {
+    const BoxState& s = f.s;
     BoxFit fit;
     fit.rounded_margin_m = rounded_margin;
-    fit.top_observed = top_observed;
+    fit.top_observed = f.top_observed;
     const double len_u = s.d[0] + s.d[1], len_v = s.d[2] + s.d[3];
     const double cu = 0.5 * (s.d[0] - s.d[1]), cv = 0.5 * (s.d[2] - s.d[3]);
     const Eigen::Vector2d nu = FaceNormal(s.yaw, 0), nv = FaceNormal(s.yaw, 2);
@@ -193,9 +169,57 @@ Result<BoxFit> FitFootprintBox(const Points& seed_points, const Points& points,
     fit.width_m = std::min(len_u, len_v);
     fit.length_axis = len_u >= len_v ? nu : nv;
     fit.height_m = s.height;
-    fit.face_points = counts;
-    fit.face_sigma_m = *std::max_element(s.sigma.begin(), s.sigma.begin() + (top_observed ? 5 : 4));
+    fit.face_points = f.counts;
+    fit.face_sigma_m =
+        *std::max_element(s.sigma.begin(), s.sigma.begin() + (f.top_observed ? 5 : 4));
     return fit;
+}
+
+}  // namespace
+
+Result<BoxFit> FitFootprintBox(const Points& seed_points, const Points& points,
+                               const BoxFitConfig& config, const ReadingRays& rays) {
+    const ReadingRays* by_ray = rays.Covers(points.size()) ? &rays : nullptr;
+    if (seed_points.size() < 10 || points.size() < 10) {
+        return Error{ErrorCode::kObjectTooSmall, "too few object points"};
+    }
+    auto seeded = SeedFootprint(seed_points, config);
+    if (!seeded) return seeded.error();
+    FaceFit f;
+    f.s = *seeded;
+    f.s.height = SeedHeight(seed_points, config.seed_top_quantile);
+    const BoxState& s = f.s;
+    const double min_side = std::min(s.d[0] + s.d[1], s.d[2] + s.d[3]);
+    const double margin = EdgeMargin(config.edge_margin_m, std::min(min_side, s.height));
+    if (min_side < 2.0 * margin + 0.01 || s.height < 2.0 * margin + 0.005) {
+        return Error{ErrorCode::kObjectTooSmall, "the object is too small to measure"};
+    }
+    f.band.fill(config.initial_band_m);
+    f.top_band = config.initial_band_m;
+    // A top seen only at grazing incidence (a tall box, a camera little above it) has too few
+    // readings to fit: the sides are fitted all the same, at the height of the highest readings,
+    // and the height is left to the enclosing cuboid (where the side faces end).
+    auto fit_top = [&] {
+        if (f.top_observed && !FitTop(points, config, by_ray, margin, f.top_band, f.s, f.counts)) {
+            f.top_observed = false;
+        }
+    };
+    for (int it = 0; it < config.iterations; ++it) {
+        fit_top();
+        if (!FitSides(points, config, by_ray, margin, f.band, f.s, f.counts)) {
+            return Error{ErrorCode::kInsufficientData,
+                         "a side face of the object is not observed well enough"};
+        }
+        for (std::size_t k = 0; k < 4; ++k) {
+            f.band[k] = std::clamp(config.band_sigmas * s.sigma[k], config.min_band_m,
+                                   config.initial_band_m);
+        }
+        f.top_band =
+            std::clamp(config.band_sigmas * s.sigma[4], config.min_band_m, config.initial_band_m);
+    }
+    fit_top();
+    const double rounded_margin = RefitClearOfRounding(points, config, by_ray, margin, f);
+    return BoxOf(f, rounded_margin);
 }
 
 OrientedBox FitPcaBox(const Points& points) {

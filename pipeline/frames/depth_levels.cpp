@@ -141,13 +141,10 @@ double NearestLevelDepth(const DepthLevels& levels, double u) {
     return 1.0 / (levels.first_per_m + k * levels.spacing_per_m);
 }
 
-}  // namespace
-
-std::optional<DepthLevels> FindDepthLevels(const std::vector<DepthImage>& frames,
-                                           double depth_unit_m) {
-    if (!(depth_unit_m > 0.0)) return std::nullopt;
-    // A few hundred thousand readings show every level many times over: with more frames, a
-    // stride through each. Four bytes a count keep the histogram in the cache.
+// The values the frames recorded, by increasing depth, with how often each was read. A few
+// hundred thousand readings show every level many times over: with more frames, a stride through
+// each. Four bytes a count keep the histogram in the cache.
+std::vector<Recorded> RecordedValues(const std::vector<DepthImage>& frames, double depth_unit_m) {
     std::size_t readings = 0;
     for (const DepthImage& f : frames) readings += f.pixels.size();
     const std::size_t stride = std::max<std::size_t>(1, readings / kEnoughReadings);
@@ -155,16 +152,19 @@ std::optional<DepthLevels> FindDepthLevels(const std::vector<DepthImage>& frames
     for (const DepthImage& f : frames) {
         for (std::size_t i = 0; i < f.pixels.size(); i += stride) ++counts[f.pixels[i]];
     }
-    std::vector<Recorded> all;  // by increasing depth
+    std::vector<Recorded> all;
     for (std::size_t v = 1; v < kValues; ++v) {
         if (counts[v] > 0) {
             all.push_back(
                 {static_cast<int>(v), 1.0 / (static_cast<double>(v) * depth_unit_m), counts[v]});
         }
     }
-    if (all.empty()) return std::nullopt;
-    // The levels are placed by the values read often (a stray value between two levels would
-    // split their pair); every reading is tested against them.
+    return all;
+}
+
+// The values read often: the levels are placed by them (a stray value between two levels would
+// split their pair); every reading is tested against them.
+std::vector<Recorded> ReadOften(const std::vector<Recorded>& all) {
     std::vector<double> seen;
     for (const Recorded& r : all) seen.push_back(static_cast<double>(r.count));
     const double often = std::max(2.0, Median(std::move(seen)) * kOftenShare);
@@ -172,11 +172,15 @@ std::optional<DepthLevels> FindDepthLevels(const std::vector<DepthImage>& frames
     for (const Recorded& r : all) {
         if (static_cast<double>(r.count) >= often) values.push_back(r);
     }
-    // The spacing where consecutive values are two units apart or more, then again where the
-    // levels that spacing gives lie kStartUnits apart or more.
-    std::vector<double> gaps;
+    return values;
+}
+
+// The levels' spacing in 1/m: the median gap where consecutive values are two units apart or
+// more, then again where the levels that spacing gives lie kStartUnits apart or more; 0 when
+// too few pairs show it.
+double LevelSpacing(const std::vector<Recorded>& values, double depth_unit_m) {
     auto pair_gaps = [&](double min_units, double spacing) {
-        gaps.clear();
+        std::vector<double> gaps;
         for (std::size_t i = 0; i + 1 < values.size(); ++i) {
             const double du = values[i].u - values[i + 1].u;
             const bool apart = spacing > 0.0
@@ -186,10 +190,33 @@ std::optional<DepthLevels> FindDepthLevels(const std::vector<DepthImage>& frames
         }
         return gaps.size() >= kMinPairs ? Median(gaps) : 0.0;
     };
-    double spacing = pair_gaps(0.0, 0.0);
-    if (spacing > 0.0) spacing = pair_gaps(kStartUnits, spacing);
-    if (!(spacing > 0.0)) return std::nullopt;
+    const double spacing = pair_gaps(0.0, 0.0);
+    return spacing > 0.0 ? pair_gaps(kStartUnits, spacing) : 0.0;
+}
 
+// The share of the readings where the levels are sparse that round from one of them.
+double OnLevelShare(const std::vector<Recorded>& all, const DepthLevels& levels,
+                    double depth_unit_m) {
+    std::uint64_t on = 0, total = 0;
+    for (const Recorded& r : all) {
+        if (SpacingUnits(levels.spacing_per_m, r.u, depth_unit_m) < kSparseUnits) continue;
+        total += r.count;
+        const double z = NearestLevelDepth(levels, r.u);
+        if (std::abs(z / depth_unit_m - r.value) <= 0.5 + kSlackUnits) on += r.count;
+    }
+    return total > 0 ? static_cast<double>(on) / static_cast<double>(total) : 0.0;
+}
+
+}  // namespace
+
+std::optional<DepthLevels> FindDepthLevels(const std::vector<DepthImage>& frames,
+                                           double depth_unit_m) {
+    if (!(depth_unit_m > 0.0)) return std::nullopt;
+    const std::vector<Recorded> all = RecordedValues(frames, depth_unit_m);
+    if (all.empty()) return std::nullopt;
+    const std::vector<Recorded> values = ReadOften(all);
+    double spacing = LevelSpacing(values, depth_unit_m);
+    if (!(spacing > 0.0)) return std::nullopt;
     std::vector<Recorded> sparse;
     for (const Recorded& r : values) {
         if (SpacingUnits(spacing, r.u, depth_unit_m) >= kSparseUnits) sparse.push_back(r);
@@ -213,14 +240,7 @@ std::optional<DepthLevels> FindDepthLevels(const std::vector<DepthImage>& frames
     levels.spacing_per_m = spacing;
     if (levels.fitted < kMinFitted) return std::nullopt;
     // Nearly every reading where the levels are sparse must round from one of them.
-    std::uint64_t on = 0, total = 0;
-    for (const Recorded& r : all) {
-        if (SpacingUnits(spacing, r.u, depth_unit_m) < kSparseUnits) continue;
-        total += r.count;
-        const double z = NearestLevelDepth(levels, r.u);
-        if (std::abs(z / depth_unit_m - r.value) <= 0.5 + kSlackUnits) on += r.count;
-    }
-    levels.on_level = total > 0 ? static_cast<double>(on) / static_cast<double>(total) : 0.0;
+    levels.on_level = OnLevelShare(all, levels, depth_unit_m);
     if (levels.on_level < kMinOnLevel) return std::nullopt;
     levels.lowest = all.front().value;
     levels.highest = all.back().value;

@@ -166,6 +166,75 @@ Status FlyingPixelConfig::Validate() const {
     return OkStatus();
 }
 
+namespace {
+
+// The recorded values' depths: their levels' where the readings come in levels
+// (depth_levels.h). Every value keeps its own depth, but for those of the span the levels were
+// found in (a value the histogram's stride passed over may lie outside it).
+void ReadLevels(const std::vector<DepthImage>& frames, double depth_unit_m, AveragingPass* pass) {
+    const auto levels = FindDepthLevels(frames, depth_unit_m);
+    if (!levels) {
+        spdlog::debug("depth levels: none (the recorded values are the depths)");
+        return;
+    }
+    spdlog::debug("depth levels: {:.9f} per m apart, {} values fitted, {:.2f}% on a level",
+                  levels->spacing_per_m, levels->fitted, 100.0 * levels->on_level);
+    pass->levels = true;
+    pass->fixed.resize(kValues);
+    for (std::size_t v = 0; v < pass->fixed.size(); ++v) {
+        pass->fixed[v] = static_cast<std::int32_t>(v) << kFixedBits;
+    }
+    for (int v = levels->lowest; v <= levels->highest; ++v) {
+        pass->fixed[static_cast<std::size_t>(v)] = static_cast<std::int32_t>(
+            std::lround(RecordedDepth(*levels, v, depth_unit_m) / depth_unit_m * kFixedScale));
+    }
+}
+
+// The agreement window of SPEC section 7's sensor model grows with depth: looked up per raw
+// median reading (in raw units) instead of computed in metres for every pixel. The last entry
+// is a pixel without readings (never used).
+std::vector<std::uint32_t> AgreementWindows(const AveragingConfig& config, double depth_unit_m) {
+    std::vector<std::uint32_t> window(kValues + 1);
+    for (std::size_t v = 0; v < window.size(); ++v) {
+        const double z = static_cast<double>(v) * depth_unit_m;
+        const double tol = config.agreement_abs_m + config.agreement_rel_per_m * z * z;
+        // Truncation is the floor here (the window is never negative), and it vectorises.
+        window[v] = static_cast<std::uint32_t>(std::min(65535.0, tol / depth_unit_m));
+    }
+    return window;
+}
+
+// Averages every pixel of `pass`'s `n` frames into `out`: a loop unrolled for each count up to
+// eight frames.
+void AverageFrames(const AveragingPass& pass, std::size_t n, DepthMap* out) {
+    switch (n) {
+        case 1:
+            return AverageWith<1>(pass, out);
+        case 2:
+            return AverageWith<2>(pass, out);
+        case 3:
+            return AverageWith<3>(pass, out);
+        case 4:
+            return AverageWith<4>(pass, out);
+        case 5:
+            return AverageWith<5>(pass, out);
+        case 6:
+            return AverageWith<6>(pass, out);
+        case 7:
+            return AverageWith<7>(pass, out);
+        case 8:
+            return AverageWith<8>(pass, out);
+        default: {
+            std::vector<std::uint16_t> r(n);
+            for (std::size_t i = 0; i < out->z_m.size(); ++i) {
+                AveragePixelAnyCount(pass, i, r.data(), &out->z_m[i]);
+            }
+        }
+    }
+}
+
+}  // namespace
+
 Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, double depth_unit_m,
                                     const AveragingConfig& config) {
     if (frames.empty()) return Error{ErrorCode::kInsufficientData, "no frames to average"};
@@ -182,70 +251,14 @@ Result<DepthMap> AverageDepthFrames(const std::vector<DepthImage>& frames, doubl
         1, static_cast<std::size_t>(std::ceil(config.min_valid_fraction * n - 1e-9)));
     pass.unit = depth_unit_m;
     for (const DepthImage& f : frames) pass.src.push_back(f.pixels.data());
-    // The recorded values' depths: their levels' where the readings come in levels
-    // (depth_levels.h).
-    const auto levels = config.depth_levels ? FindDepthLevels(frames, depth_unit_m) : std::nullopt;
-    if (levels) {
-        spdlog::debug("depth levels: {:.9f} per m apart, {} values fitted, {:.2f}% on a level",
-                      levels->spacing_per_m, levels->fitted, 100.0 * levels->on_level);
+    if (config.depth_levels) {
+        ReadLevels(frames, depth_unit_m, &pass);
     } else {
         spdlog::debug("depth levels: none (the recorded values are the depths)");
     }
-    pass.levels = levels.has_value();
-    if (levels) {
-        // Every value keeps its own depth, but for those of the span the levels were found in
-        // (a value the histogram's stride passed over may lie outside it).
-        pass.fixed.resize(kValues);
-        for (std::size_t v = 0; v < pass.fixed.size(); ++v) {
-            pass.fixed[v] = static_cast<std::int32_t>(v) << kFixedBits;
-        }
-        for (int v = levels->lowest; v <= levels->highest; ++v) {
-            pass.fixed[static_cast<std::size_t>(v)] = static_cast<std::int32_t>(
-                std::lround(RecordedDepth(*levels, v, depth_unit_m) / depth_unit_m * kFixedScale));
-        }
-    }
-    // The agreement window of SPEC section 7's sensor model grows with depth: looked up per raw
-    // median reading (in raw units) instead of computed in metres for every pixel.
-    pass.window.resize(kValues + 1);  // the last entry: a pixel without readings (never used)
-    for (std::size_t v = 0; v < pass.window.size(); ++v) {
-        const double z = static_cast<double>(v) * depth_unit_m;
-        const double tol = config.agreement_abs_m + config.agreement_rel_per_m * z * z;
-        // Truncation is the floor here (the window is never negative), and it vectorises.
-        pass.window[v] = static_cast<std::uint32_t>(std::min(65535.0, tol / depth_unit_m));
-    }
+    pass.window = AgreementWindows(config, depth_unit_m);
     DepthMap out(w, h);
-    switch (n) {
-        case 1:
-            AverageWith<1>(pass, &out);
-            break;
-        case 2:
-            AverageWith<2>(pass, &out);
-            break;
-        case 3:
-            AverageWith<3>(pass, &out);
-            break;
-        case 4:
-            AverageWith<4>(pass, &out);
-            break;
-        case 5:
-            AverageWith<5>(pass, &out);
-            break;
-        case 6:
-            AverageWith<6>(pass, &out);
-            break;
-        case 7:
-            AverageWith<7>(pass, &out);
-            break;
-        case 8:
-            AverageWith<8>(pass, &out);
-            break;
-        default: {
-            std::vector<std::uint16_t> r(n);
-            for (std::size_t i = 0; i < out.z_m.size(); ++i) {
-                AveragePixelAnyCount(pass, i, r.data(), &out.z_m[i]);
-            }
-        }
-    }
+    AverageFrames(pass, n, &out);
     return out;
 }
 
