@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 
 #include "pipeline/core/student_t.h"
+#include "pipeline/envelope/cuboid_bounds.h"
 #include "pipeline/envelope/enclosing_cuboid.h"
 #include "pipeline/envelope/registration_uncertainty.h"
 #include "pipeline/envelope/top_rounding.h"
@@ -22,15 +24,23 @@ namespace boxd {
 
 namespace {
 
-// The result as the stages fill it in.
+// The result as the stages fill it in. Its laps are those the stream counted pose by pose (the
+// views in "preprocess", the alignments in "registration") and the stages' after the last pose.
 struct Measurement {
-    explicit Measurement(const MonotonicMs& clock) : laps(clock) {}
+    Measurement(const MonotonicMs& clock, const ViewStream& stream) : laps(clock), stream(stream) {}
+
+    std::map<std::string, double> Timing() const {
+        std::map<std::string, double> ms = laps.ms();
+        ms["preprocess"] += stream.segment_ms();
+        ms["registration"] += stream.align_ms();
+        return ms;
+    }
 
     MeasureOutput Refused(const MeasurementReason& why) {
         spdlog::info("measure: no dimension: {}: {}", ErrorCodeName(why.code), why.message);
         out.result.status = MeasurementStatus::kNoDim;
         out.result.reason = why;
-        out.result.timing_ms = laps.ms();
+        out.result.timing_ms = Timing();
         return std::move(out);
     }
 
@@ -59,12 +69,13 @@ struct Measurement {
         out.result.status = MeasurementStatus::kOk;
         out.result.dimensions = dims;
         out.result.obb = fit.pca;
-        out.result.timing_ms = laps.ms();
+        out.result.timing_ms = Timing();
         return std::move(out);
     }
 
     MeasureOutput out;
     StageLaps laps;
+    const ViewStream& stream;
 };
 
 // Returns quality.confidence (ConfidenceConfig).
@@ -89,57 +100,12 @@ void AddTableReadings(ObjectViews& views, const std::vector<Se2>& poses, FusedCl
     fused->table_known = true;
 }
 
-// The 95% bounds of `cuboid` (SPEC section 5's uncertainty_m): the faces' own scatter, what the
-// registration may still have moved them by, and for the height the table's centre and the
-// depths' rounding.
-std::array<double, 3> Bounds95(const Session& session, const FusedFit& fit,
-                               const EnclosingCuboid& cuboid, const RegisteredViews& registered,
-                               const TablePlaneFit& table, const MultipathShare& multipath,
-                               const MeasureConfig& config) {
-    // The faces' own scatter, and what the registration may still have moved them by; the
-    // height is read from the table's plane, which is known as well as its poses agree.
-    const auto moved =
-        RegistrationSigma(fit.fused, cuboid, registered.poses, registered.pose_covariance);
-    spdlog::debug(
-        "uncertainty: faces {:.3f} {:.3f} {:.3f} mm, registration {:.3f} {:.3f} mm, table "
-        "{:.3f} mm",
-        cuboid.sigma_m[0] * 1e3, cuboid.sigma_m[1] * 1e3, cuboid.sigma_m[2] * 1e3, moved[0] * 1e3,
-        moved[1] * 1e3, table.center_se_m * 1e3);
-    // The rounding of the recorded depths, which every view of the top and every pose of
-    // the table meet alike (depth_rounding.h): the two surfaces lie at other depths, so
-    // their roundings are independent.
-    const double unit = session.camera.depth_unit_m;
-    const double rounding = std::hypot(
-        SharedRoundingSigma(TopRounding(fit.fused, registered.poses, cuboid, table.camera_to_table,
-                                        session.calibration, config.box_fit.min_band_m,
-                                        EdgeMargin(config.envelope.edge_margin_m,
-                                                   std::min(cuboid.width_m, cuboid.height_m),
-                                                   fit.box ? fit.box->rounded_margin_m : 0.0)),
-                            unit),
-        SharedRoundingSigma(table.rounding, unit));
-    spdlog::debug("uncertainty: the depths' rounding {:.3f} mm in the height", rounding * 1e3);
-    const double shared[3] = {moved[0], moved[1], std::hypot(table.center_se_m, rounding)};
-    // A time-of-flight camera's multipath correction, trusted to within its own size
-    // (multipath_correction.h): a 95% bound of the walls' in the length and width, of all the
-    // object's in the height.
-    spdlog::debug("uncertainty: multipath corrections of {:.3f} mm (walls {:.3f} mm)",
-                  multipath.object_m * 1e3, multipath.walls_m * 1e3);
-    const double corrected[3] = {multipath.walls_m, multipath.walls_m, multipath.object_m};
-    std::array<double, 3> uncertainty{};
-    for (std::size_t i = 0; i < 3; ++i) {
-        // kNormal95 sigmas: the 95% bound of SPEC section 5's uncertainty_m.
-        uncertainty[i] =
-            kNormal95 * std::hypot(cuboid.sigma_m[i], shared[i], corrected[i] / kNormal95);
-    }
-    return uncertainty;
-}
-
 // Stages 4b to 7 on the views and edges of `stream`.
 MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const MeasureConfig& config,
                            BoxMethod method, const MonotonicMs& clock) {
     const int n = static_cast<int>(session.poses.size());
     const RefusalConfig& refuse = config.refusal;
-    Measurement m(clock);
+    Measurement m(clock, stream);
     MeasurementQuality& quality = m.out.result.quality;
     quality.poses = n;
 
@@ -187,8 +153,10 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
         quality.face_excess_ratio = cuboid->max_relative_excess;
         quality.cuboid_assumed = cuboid->assumed;
         if (std::isfinite(cuboid->flatness)) quality.face_flatness = cuboid->flatness;
-        uncertainty =
-            Bounds95(session, fit, *cuboid, *registered, table, stream.multipath(), config);
+        const BoundSettings settings{session.camera.depth_unit_m, config.box_fit.min_band_m,
+                                     config.envelope.edge_margin_m};
+        uncertainty = CuboidBounds95(fit, *cuboid, *registered, table, session.calibration,
+                                     stream.multipath(), settings);
     }
     auto why = CheckEnclosingCuboid(fit, cuboid, uncertainty, refuse);
     m.out.cloud = std::move(fit.fused.points);
@@ -204,10 +172,13 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
 
 }  // namespace
 
-Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<PreparedPose> poses,
-                                      const MeasureConfig& config, BoxMethod method,
-                                      const MonotonicMs& clock) {
-    if (Status s = config.Validate(); !s) return s.error();
+namespace {
+
+// Stages 2 to 7 on the prepared poses of `session`, through a stream fed them at once (the
+// config is valid).
+Result<MeasureOutput> MeasurePoses(const Session& session, std::vector<PreparedPose> poses,
+                                   const MeasureConfig& config, BoxMethod method,
+                                   const MonotonicMs& clock) {
     if (poses.size() != session.poses.size()) {
         return Error{ErrorCode::kInternal, "MeasurePrepared: " + std::to_string(poses.size()) +
                                                " prepared poses for a session of " +
@@ -215,7 +186,31 @@ Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<Prepar
     }
     ViewStream stream(session, session.PoseAnglesDeg(), config, clock);
     stream.AddAll(std::move(poses));
-    return MeasureStreamed(session, stream, config, method, clock);
+    return MeasureViews(session, stream, config, method, clock);
+}
+
+// MeasurePoses of the poses `prepare` returns, its time counted in the "preprocess" lap.
+template <typename Prepare>
+Result<MeasureOutput> MeasureAfter(const Session& header, Prepare&& prepare,
+                                   const MeasureConfig& config, BoxMethod method,
+                                   const MonotonicMs& clock) {
+    if (Status s = config.Validate(); !s) return s.error();
+    StageLaps first_stage(clock);
+    Result<std::vector<PreparedPose>> prepared = prepare();
+    if (!prepared) return prepared.error();
+    first_stage.Lap("preprocess");
+    auto out = MeasurePoses(header, std::move(*prepared), config, method, clock);
+    if (out) out->result.timing_ms["preprocess"] += first_stage.ms().at("preprocess");
+    return out;
+}
+
+}  // namespace
+
+Result<MeasureOutput> MeasurePrepared(const Session& session, std::vector<PreparedPose> poses,
+                                      const MeasureConfig& config, BoxMethod method,
+                                      const MonotonicMs& clock) {
+    if (Status s = config.Validate(); !s) return s.error();
+    return MeasurePoses(session, std::move(poses), config, method, clock);
 }
 
 Result<MeasureOutput> MeasureStreamed(const Session& session, ViewStream& stream,
@@ -227,31 +222,8 @@ Result<MeasureOutput> MeasureStreamed(const Session& session, ViewStream& stream
                                                std::to_string(stream.Added()) +
                                                " poses, not those of the session"};
     }
-    auto out = MeasureViews(session, stream, config, method, clock);
-    // The stages the stream did pose by pose count in their laps (the refit is in "preprocess").
-    out.result.timing_ms["preprocess"] += stream.segment_ms();
-    out.result.timing_ms["registration"] += stream.align_ms();
-    return out;
+    return MeasureViews(session, stream, config, method, clock);
 }
-
-namespace {
-
-// MeasurePrepared of the poses `prepare` returns, its time counted in the "preprocess" lap.
-template <typename Prepare>
-Result<MeasureOutput> MeasureAfter(const Session& header, Prepare&& prepare,
-                                   const MeasureConfig& config, BoxMethod method,
-                                   const MonotonicMs& clock) {
-    if (Status s = config.Validate(); !s) return s.error();
-    StageLaps first_stage(clock);
-    Result<std::vector<PreparedPose>> prepared = prepare();
-    if (!prepared) return prepared.error();
-    first_stage.Lap("preprocess");
-    auto out = MeasurePrepared(header, std::move(*prepared), config, method, clock);
-    if (out) out->result.timing_ms["preprocess"] += first_stage.ms().at("preprocess");
-    return out;
-}
-
-}  // namespace
 
 Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig& config,
                                      BoxMethod method, const MonotonicMs& clock) {

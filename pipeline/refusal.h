@@ -1,7 +1,10 @@
 #pragma once
 // The refusal rules: when the measurement gives no size rather than a wrong one (SPEC section 5:
 // a confident wrong size costs a carrier money, a no_dim costs a re-scan). Every rule the recipe
-// applies is here, in the order the stages reach them; each returns the reason, or nullopt.
+// applies between its stages is here, in the order the stages reach them; each returns the
+// reason, or nullopt. A stage that cannot compute its output at all (no table plane, no top a
+// single view can bound, a foot nothing bounds) returns its own error with the reason, and the
+// rule after it passes that on (CheckFusedFit, CheckEnclosingCuboid).
 
 #include <array>
 #include <optional>

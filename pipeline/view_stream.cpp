@@ -99,6 +99,8 @@ std::unique_ptr<ViewStream> ViewStream::SoFar() const {
               copy->views_.clouds.begin());
     copy->alignments_ = alignments_;
     copy->multipath_ = multipath_;
+    copy->segment_ms_ = segment_ms_;  // the copy's laps are those of its poses
+    copy->align_ms_ = align_ms_;
     return copy;
 }
 

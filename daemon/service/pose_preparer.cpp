@@ -93,9 +93,6 @@ void PosePreparer::TryDetermine() {
                   std::isfinite(worst) ? "a flat-faced cuboid" : "no flat-faced cuboid",
                   worst * 1e3);
     if (!(worst <= target_m_)) return done(true, worst, std::nullopt);
-    // The stages the stream did pose by pose count in their laps, as in MeasureStreamed.
-    out->result.timing_ms["preprocess"] += stream_.segment_ms();
-    out->result.timing_ms["registration"] += stream_.align_ms();
     done(true, worst, std::move(*out));
 }
 

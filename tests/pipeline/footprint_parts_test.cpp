@@ -85,6 +85,22 @@ TEST(SeparateFootprint, ParcelsCloserThanTheLinkAreOne) {
     EXPECT_EQ(Objects(SeparateFootprint(pts, 0.02, kLink, kStray)), 1);
 }
 
+TEST(SeparateFootprint, ASparselyReadTopStaysOnePart) {
+    // A top read in clusters 14 mm apart (a flat carton from four poses and a low camera: one
+    // cluster of three readings every 14 mm), wider apart than the 1 cm link: each cluster's cell
+    // holds two or three readings, so its readings link as far as their spacing stretched along
+    // the view, and the top is one part.
+    Points pts;
+    for (double x = -0.12; x <= 0.12; x += 0.014) {
+        for (double y = -0.08; y <= 0.08; y += 0.014) {
+            for (int k = 0; k < 3; ++k) {
+                pts.emplace_back(static_cast<float>(x + 0.001 * k), static_cast<float>(y), 0.09f);
+            }
+        }
+    }
+    EXPECT_EQ(Objects(SeparateFootprint(pts, 0.02, kLink, kStray)), 1);
+}
+
 TEST(SeparateFootprint, LowReadingsAndLoneStraysAreNoPart) {
     Points pts;
     AddBlock(pts, -0.15, 0.15, -0.1, 0.1, 0.2);

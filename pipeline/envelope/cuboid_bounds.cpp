@@ -1,0 +1,59 @@
+#include "pipeline/envelope/cuboid_bounds.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "pipeline/core/student_t.h"
+#include "pipeline/envelope/registration_uncertainty.h"
+#include "pipeline/envelope/top_rounding.h"
+#include "pipeline/fit/face_choice.h"
+#include "pipeline/views/depth_rounding.h"
+
+namespace boxd {
+
+std::array<double, 3> CuboidBounds95(const FusedFit& fit, const EnclosingCuboid& cuboid,
+                                     const RegisteredViews& registered, const TablePlaneFit& table,
+                                     const StationCalibration& calibration,
+                                     const MultipathShare& multipath,
+                                     const BoundSettings& settings) {
+    // The faces' own scatter, and what the registration may still have moved them by; the
+    // height is read from the table's plane, which is known as well as its poses agree.
+    const auto moved =
+        RegistrationSigma(fit.fused, cuboid, registered.poses, registered.pose_covariance);
+    spdlog::debug(
+        "uncertainty: faces {:.3f} {:.3f} {:.3f} mm, registration {:.3f} {:.3f} mm, table "
+        "{:.3f} mm",
+        cuboid.sigma_m[0] * 1e3, cuboid.sigma_m[1] * 1e3, cuboid.sigma_m[2] * 1e3, moved[0] * 1e3,
+        moved[1] * 1e3, table.center_se_m * 1e3);
+    // The rounding of the recorded depths, which every view of the top and every pose of
+    // the table meet alike (depth_rounding.h): the two surfaces lie at other depths, so
+    // their roundings are independent.
+    const double unit = settings.depth_unit_m;
+    const double rounding = std::hypot(
+        SharedRoundingSigma(TopRounding(fit.fused, registered.poses, cuboid, table.camera_to_table,
+                                        calibration, settings.min_band_m,
+                                        EdgeMargin(settings.edge_margin_m,
+                                                   std::min(cuboid.width_m, cuboid.height_m),
+                                                   fit.box ? fit.box->rounded_margin_m : 0.0)),
+                            unit),
+        SharedRoundingSigma(table.rounding, unit));
+    spdlog::debug("uncertainty: the depths' rounding {:.3f} mm in the height", rounding * 1e3);
+    const double shared[3] = {moved[0], moved[1], std::hypot(table.center_se_m, rounding)};
+    // A time-of-flight camera's multipath correction, trusted to within its own size
+    // (multipath_correction.h): a 95% bound of the walls' in the length and width, of all the
+    // object's in the height.
+    spdlog::debug("uncertainty: multipath corrections of {:.3f} mm (walls {:.3f} mm)",
+                  multipath.object_m * 1e3, multipath.walls_m * 1e3);
+    const double corrected[3] = {multipath.walls_m, multipath.walls_m, multipath.object_m};
+    std::array<double, 3> uncertainty{};
+    for (std::size_t i = 0; i < 3; ++i) {
+        // kNormal95 sigmas: the 95% bound of SPEC section 5's uncertainty_m.
+        uncertainty[i] =
+            kNormal95 * std::hypot(cuboid.sigma_m[i], shared[i], corrected[i] / kNormal95);
+    }
+    return uncertainty;
+}
+
+}  // namespace boxd
