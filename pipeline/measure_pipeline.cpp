@@ -134,7 +134,8 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
                               &m.laps, table.camera_to_table.translation().cast<float>());
     quality.points = static_cast<long>(fit.fused.points.size());
     if (n > 1) AddTableReadings(views, registered->poses, &fit.fused);
-    if (auto why = CheckSingleObject(fit.fused, refuse)) {
+    const Points& table_read = n > 1 ? fit.fused.table : views.views[0].table_points;
+    if (auto why = CheckSingleObject(fit.fused, table_read, refuse)) {
         m.out.cloud = std::move(fit.fused.points);
         return m.Refused(*why);
     }

@@ -163,11 +163,19 @@ std::optional<MeasurementReason> CheckFusedFit(const FusedFit& fit, const Refusa
 // objects, sparse RealSense tops included, and drops the single stray readings.
 constexpr double kStrayShareOfMedian = 1.0 / 8.0;
 
-std::optional<MeasurementReason> CheckSingleObject(const FusedCloud& fused,
+// Across table nothing read, readings join as far as two cells' diagonal: as far as 8-connected
+// cells of the footprint's grid join them.
+constexpr double kUnreadReachCells = 2.0 * M_SQRT2;
+
+std::optional<MeasurementReason> CheckSingleObject(const FusedCloud& fused, const Points& table,
                                                    const RefusalConfig& refuse) {
     // Readings lower than two cells are the table's (a flat scrap is no object).
-    const FootprintParts parts = SeparateFootprint(fused.points, 2.0 * refuse.object_cell_m,
-                                                   refuse.object_cell_m, kStrayShareOfMedian);
+    FootprintLinks links;
+    links.min_height_m = 2.0 * refuse.object_cell_m;
+    links.link_m = refuse.object_cell_m;
+    links.unread_reach_m = kUnreadReachCells * refuse.object_cell_m;
+    links.stray_share = kStrayShareOfMedian;
+    const FootprintParts parts = SeparateFootprint(fused.points, table, links);
     int objects = 0;
     for (double area : parts.area_m2) {
         objects += area >= refuse.min_object_share * parts.total_m2 ? 1 : 0;

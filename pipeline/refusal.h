@@ -35,9 +35,9 @@ struct RefusalConfig {
     // Box faces rougher than this (robust sigma of the face fits) are not faces of one rigid box
     // seen from registered views.
     double max_face_sigma_m = 0.01;
-    // Separate objects: readings farther apart than this across the table, with no reading
-    // between, belong to separate parts of the footprint (footprint_parts.h); parts holding at
-    // least this share of the footprint count as objects.
+    // Separate objects: readings farther apart than this across the table belong to separate
+    // parts of the footprint where the table was seen free between them (footprint_parts.h);
+    // parts holding at least this share of the footprint count as objects.
     double object_cell_m = 0.01;
     double min_object_share = 0.05;
     // A dimension whose 95% uncertainty exceeds this is not reported: UNCERTAIN.
@@ -67,8 +67,9 @@ std::optional<MeasurementReason> CheckRegisteredViews(const RegisteredViews& reg
 std::optional<MeasurementReason> CheckFusedFit(const FusedFit& fit, const RefusalConfig& refuse);
 
 // Separate objects on the table: MULTIPLE_OBJECTS when the fused cloud's footprint falls apart
-// into more than one part of substance (no single size describes them).
-std::optional<MeasurementReason> CheckSingleObject(const FusedCloud& fused,
+// into more than one part of substance (no single size describes them), the table's readings
+// `table` (table frame) showing where the table was seen free between them (footprint_parts.h).
+std::optional<MeasurementReason> CheckSingleObject(const FusedCloud& fused, const Points& table,
                                                    const RefusalConfig& refuse);
 
 // The enclosing cuboid of the fused cloud: NO_OBJECT when too few points survive fusion, the

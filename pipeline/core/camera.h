@@ -1,5 +1,5 @@
 #pragma once
-// Pinhole depth-camera intrinsics (OpenCV convention: x right, y down, z forward).
+// Core: Pinhole depth-camera intrinsics (OpenCV convention: x right, y down, z forward).
 
 #include <Eigen/Core>
 #include <string>

@@ -1,5 +1,6 @@
 #pragma once
-// Depth images: raw 16-bit frames as the camera delivers them, and float depth maps in metres.
+// Core: Depth images: raw 16-bit frames as the camera delivers them, and float depth maps in
+// metres.
 
 #include <cstdint>
 #include <vector>

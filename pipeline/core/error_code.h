@@ -1,5 +1,5 @@
 #pragma once
-// ErrorCode: every error and refusal code boxd reports, each with one category. The category,
+// Core: ErrorCode: every error and refusal code boxd reports, each with one category. The category,
 // never the code, decides the HTTP status (HttpStatusOf) and the exit code (ExitCodeOf), so a new
 // code cannot silently become a 500. The codes' names are what the JSON carries (SPEC sections 5
 // and 6): stable, upper snake case.

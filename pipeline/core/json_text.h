@@ -1,5 +1,5 @@
 #pragma once
-// The one way boxd turns JSON into text. Strings in a document may carry bytes from outside
+// Core: The one way boxd turns JSON into text. Strings in a document may carry bytes from outside
 // (a request path, a file name, a parcel id): bytes that are not UTF-8 are written as U+FFFD
 // instead of making nlohmann::json throw in the middle of an answer.
 

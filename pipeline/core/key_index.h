@@ -1,5 +1,5 @@
 #pragma once
-// Dense indices for 64-bit keys (voxels, grid cells) in order of first appearance: an
+// Core: Dense indices for 64-bit keys (voxels, grid cells) in order of first appearance: an
 // open-addressing hash table (Fibonacci hashing, Knuth TAOCP 6.4, linear probing) kept at most
 // half full. It starts small and doubles: a cloud has far fewer voxels than points, and a table
 // that fits the cache is what makes it several times faster than std::unordered_map here.

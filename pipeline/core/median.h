@@ -1,5 +1,5 @@
 #pragma once
-// The median and quantiles the pipeline's robust statistics share.
+// Core: The median and quantiles the pipeline's robust statistics share.
 
 #include <algorithm>
 #include <limits>

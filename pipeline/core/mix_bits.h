@@ -1,5 +1,5 @@
 #pragma once
-// A well-mixed 64-bit value of a 64-bit key: the splitmix64 finaliser (Steele, Lea and Flood,
+// Core: A well-mixed 64-bit value of a 64-bit key: the splitmix64 finaliser (Steele, Lea and Flood,
 // "Fast splittable pseudorandom number generators", OOPSLA 2014). Nearby keys (neighbouring
 // pixels, blocks, seeds) give unrelated values, the same on every machine and thread.
 

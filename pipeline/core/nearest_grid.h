@@ -1,6 +1,6 @@
 #pragma once
-// Exact nearest-neighbour lookup within a radius on a uniform grid: the hot loop of ICP, where
-// every source point asks for its nearest target point within the correspondence gate.
+// Core: Exact nearest-neighbour lookup within a radius on a uniform grid: the hot loop of ICP,
+// where every source point asks for its nearest target point within the correspondence gate.
 
 #include <Eigen/Core>
 #include <array>

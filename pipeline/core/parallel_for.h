@@ -1,5 +1,5 @@
 #pragma once
-// A minimal parallel loop: threads take the next index from a shared counter (so uneven work
+// Core: A minimal parallel loop: threads take the next index from a shared counter (so uneven work
 // balances), and results go to per-index slots, so the outcome never depends on thread timing.
 
 #include <algorithm>

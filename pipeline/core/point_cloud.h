@@ -1,5 +1,6 @@
 #pragma once
-// Point clouds as plain data: float points (metres) in a named frame, no PCL types in headers.
+// Core: Point clouds as plain data: float points (metres) in a named frame, no PCL types in
+// headers.
 
 #include <Eigen/Core>
 #include <cmath>

@@ -1,5 +1,5 @@
 #pragma once
-// Result<T>: the value of an operation that can fail in an expected way (bad input, a device
+// Core: Result<T>: the value of an operation that can fail in an expected way (bad input, a device
 // error, "no solution"). Failures carry a stable machine-readable code and a human message.
 
 #include <string>

@@ -1,6 +1,6 @@
 #pragma once
-// Planar rigid motions (SE(2)) in the table frame. Every turntable view differs from pose 0 by a
-// rotation about the table normal plus a shift in the table plane, so registration works in
+// Core: Planar rigid motions (SE(2)) in the table frame. Every turntable view differs from pose 0
+// by a rotation about the table normal plus a shift in the table plane, so registration works in
 // (x, y, yaw) and leaves z untouched.
 
 #include <Eigen/Core>

@@ -1,5 +1,5 @@
 #pragma once
-// StageLaps: the per-stage durations of SPEC section 5's `timing_ms`, read from a clock the
+// Core: StageLaps: the per-stage durations of SPEC section 5's `timing_ms`, read from a clock the
 // caller supplies. The pipeline never reads a clock itself: the daemon and the command line are
 // the edges that own time (and ids and timestamps); without a clock every lap is 0 ms.
 

@@ -1,5 +1,6 @@
 #pragma once
-// The station calibration: where the turntable is, seen from the camera, and the depth correction.
+// Core: The station calibration: where the turntable is, seen from the camera, and the depth
+// correction.
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>

@@ -1,5 +1,5 @@
 #pragma once
-// Student's t: how much wider a 95% bound must be when the standard error it multiplies was
+// Core: Student's t: how much wider a 95% bound must be when the standard error it multiplies was
 // itself estimated from a few samples (a face's offset from the views that saw it, the table's
 // height from its poses). With n samples the bound is t(n - 1) standard errors, not 1.96: 12.7
 // from two samples, 2.1 from eighteen.

@@ -1,6 +1,6 @@
 #pragma once
-// A face that bows out smoothly: a full carton's panel, pushed out in the middle and held flat
-// at its edges. Where its crest stands.
+// Envelope stage: a face that bows out smoothly: a full carton's panel, pushed out in the middle
+// and held flat at its edges. Where its crest stands.
 //
 // Why. A face's cells are judged one by one for standing out (face_envelope.cpp): right for a
 // strap or a label, which stand out by a step, but a panel that bows out by a millimetre or two

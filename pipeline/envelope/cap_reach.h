@@ -1,7 +1,7 @@
 #pragma once
-// The reach of a smooth cap read across cells: where an outer layer rounds over (a soft bag's
-// end, a bulging panel of an irregular object), the cells near its crest all read nearly as
-// far, and the noise correction of LargestBound, which takes its contenders for equals, takes
+// Envelope stage: the reach of a smooth cap read across cells: where an outer layer rounds over (a
+// soft bag's end, a bulging panel of an irregular object), the cells near its crest all read nearly
+// as far, and the noise correction of LargestBound, which takes its contenders for equals, takes
 // off the largest of that many draws from a crest whose cells fall away from it: a bag read
 // 0.2-0.8 mm short on every side. Fitted over the cells around the crest, a quadratic surface
 // knows how far each cell falls short, and its vertex is the crest.

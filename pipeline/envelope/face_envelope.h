@@ -1,7 +1,7 @@
 #pragma once
-// The faces of a fitted box, cell by cell: how far each of its 4 sides and its top stands out
-// of its fitted plane (a bulge, a strap, a label), and how well its plane is known from the
-// views. The cuboid half of the enclosing cuboid (enclosing_cuboid.h).
+// Envelope stage: the faces of a fitted box, cell by cell: how far each of its 4 sides and its top
+// stands out of its fitted plane (a bulge, a strap, a label), and how well its plane is known from
+// the views. The cuboid half of the enclosing cuboid (enclosing_cuboid.h).
 
 #include <array>
 #include <limits>

@@ -1,5 +1,5 @@
 #pragma once
-// Where a face stands out over a patch of its cells: a strap's band, a label.
+// Envelope stage: where a face stands out over a patch of its cells: a strap's band, a label.
 //
 // Why. A face's cells are judged one by one (face_envelope.cpp), each against the Bonferroni
 // confidence over all the face's cells. A cell is a few views' readings: on a noisy sensor

@@ -1,9 +1,9 @@
 #pragma once
-// The foot band: the readings within EnvelopeConfig::min_z_m of the table are taken as table, so
-// the last centimetre of every wall is read by nothing. Where a wall stands upright that costs
-// nothing; where it slopes outward down to the table (a prism or a wedge lying on a face, a
-// frustum, a pyramid, a sack) its widest part is in that band, and the support read above it
-// falls short by the slope times the band's height (a 60 degree flank read 13 mm narrow over a
+// Envelope stage: the foot band: the readings within EnvelopeConfig::min_z_m of the table are taken
+// as table, so the last centimetre of every wall is read by nothing. Where a wall stands upright
+// that costs nothing; where it slopes outward down to the table (a prism or a wedge lying on a
+// face, a frustum, a pyramid, a sack) its widest part is in that band, and the support read above
+// it falls short by the slope times the band's height (a 60 degree flank read 13 mm narrow over a
 // 12 mm band). The principle (enclosing_cuboid.h): what no reading supports is carried by
 // physics into the reach and its bound. Here: the wall's profile just above the band (a line
 // through its lowest rows of cells, up to five) is extended down to the table; the line's

@@ -1,6 +1,6 @@
 #pragma once
-// Where an outer layer's cell reaches above its readings' mean: a slope going on downhill, the
-// top of a smooth cap, a ridge (support_envelope.cpp). Each mark sets the cell's
+// Envelope stage: where an outer layer's cell reaches above its readings' mean: a slope going on
+// downhill, the top of a smooth cap, a ridge (support_envelope.cpp). Each mark sets the cell's
 // high_end_above_mean_m or cap_above_mean_m, which LargestBound reads (surface_cells.h).
 
 #include "pipeline/envelope/enclosing_cuboid.h"

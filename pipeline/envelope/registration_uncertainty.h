@@ -1,6 +1,6 @@
 #pragma once
-// The part of a dimension's uncertainty that the registration leaves: where the views' poses
-// may still be wrong, the faces their points form move with them.
+// Envelope stage: the part of a dimension's uncertainty that the registration leaves: where the
+// views' poses may still be wrong, the faces their points form move with them.
 //
 // Method. A side face's position is the mean offset of its points; the points of view k move
 // with that view's pose X_k = (t, θ), so to first order the face moves by

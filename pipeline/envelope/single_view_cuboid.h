@@ -1,5 +1,6 @@
 #pragma once
-// The enclosing cuboid of a single view (enclosing_cuboid.h): the cuboid is assumed.
+// Envelope stage: the enclosing cuboid of a single view (enclosing_cuboid.h): the cuboid is
+// assumed.
 
 #include "pipeline/core/result.h"
 #include "pipeline/envelope/enclosing_cuboid.h"

@@ -1,8 +1,8 @@
 #pragma once
-// The support function of a surface: how far its outer layer reaches in each direction, read
-// from cells of that layer (surface_cells.h). The footprint is the least-area rectangle of the
-// support over all directions and the height the top's reach: the enclosing cuboid of objects
-// without flat faces (enclosing_cuboid.h).
+// Envelope stage: the support function of a surface: how far its outer layer reaches in each
+// direction, read from cells of that layer (surface_cells.h). The footprint is the least-area
+// rectangle of the support over all directions and the height the top's reach: the enclosing cuboid
+// of objects without flat faces (enclosing_cuboid.h).
 
 #include <Eigen/Core>
 #include <vector>

@@ -1,8 +1,8 @@
 #pragma once
-// Surface cells: the statistics the enclosing cuboid (enclosing_cuboid.h) is built from. The
-// cloud's readings are binned into small cells of a surface or of a direction's outer layer; a
-// cell's mean has the noise of sigma / sqrt(n), and how far the surface reaches is read from
-// the cells whose means could be the largest, corrected for the largest of that much noise.
+// Envelope stage: surface cells: the statistics the enclosing cuboid (enclosing_cuboid.h) is built
+// from. The cloud's readings are binned into small cells of a surface or of a direction's outer
+// layer; a cell's mean has the noise of sigma / sqrt(n), and how far the surface reaches is read
+// from the cells whose means could be the largest, corrected for the largest of that much noise.
 
 #include <Eigen/Core>
 #include <algorithm>

@@ -1,7 +1,7 @@
 #pragma once
-// The top's readings as the rounding of their recorded depths sees them (depth_rounding.h): a
-// horizontal top meets the same rounding in every view, so what it leaves in the height is
-// shared by the views and their agreement cannot show it.
+// Envelope stage: the top's readings as the rounding of their recorded depths sees them
+// (depth_rounding.h): a horizontal top meets the same rounding in every view, so what it leaves in
+// the height is shared by the views and their agreement cannot show it.
 
 #include <Eigen/Geometry>
 #include <vector>

@@ -1,7 +1,7 @@
 #pragma once
-// The box fit's face passes (box_fit.h): the four sides and the top fitted to their readings
-// with a margin from their edges, and the readings beyond the margin by how far inside their
-// edges they lie (rounded_edges.h).
+// Fit stage: the box fit's face passes (box_fit.h): the four sides and the top fitted to their
+// readings with a margin from their edges, and the readings beyond the margin by how far inside
+// their edges they lie (rounded_edges.h).
 
 #include <Eigen/Core>
 #include <array>

@@ -1,6 +1,6 @@
 #pragma once
-// Which readings a face fit takes (box_fit.h): a face's margins read where a reading's ray meets
-// the face's plane.
+// Fit stage: which readings a face fit takes (box_fit.h): a face's margins read where a reading's
+// ray meets the face's plane.
 
 #include <Eigen/Core>
 #include <algorithm>

@@ -1,6 +1,6 @@
 #pragma once
-// How far a box's faces round off at their edges: the face fits' margin widened to where the
-// faces' readings stop falling inwards towards the edges (box_fit.h).
+// Fit stage: how far a box's faces round off at their edges: the face fits' margin widened to where
+// the faces' readings stop falling inwards towards the edges (box_fit.h).
 
 #include <vector>
 

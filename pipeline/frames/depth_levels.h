@@ -1,5 +1,5 @@
 #pragma once
-// The depth levels of a triangulating sensor, found in its own readings.
+// Frames stage: the depth levels of a triangulating sensor, found in its own readings.
 //
 // Method. A structured-light or stereo camera measures a disparity in fixed sub-pixel steps and
 // reports z = c / d, so its readings come in levels evenly spaced in 1/z (SPEC section 7: the

@@ -1,5 +1,5 @@
 #pragma once
-// The measurement result of SPEC section 5, and its JSON form.
+// Input and output: The measurement result of SPEC section 5, and its JSON form.
 
 #include <array>
 #include <map>

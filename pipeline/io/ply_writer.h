@@ -1,6 +1,6 @@
 #pragma once
-// Writing point clouds as binary little-endian PLY (x, y, z floats), readable by PCL, Open3D,
-// MeshLab and CloudCompare.
+// Input and output: Writing point clouds as binary little-endian PLY (x, y, z floats), readable by
+// PCL, Open3D, MeshLab and CloudCompare.
 
 #include <filesystem>
 

@@ -1,8 +1,8 @@
 #pragma once
-// 16-bit single-channel PNG files — the session format's depth frames (SPEC section 3) — read and
-// written with libpng; reading takes the faster libdeflate path of png16_decode.h when it can.
-// Not OpenCV's imgcodecs: on Debian it links GDAL, and loading its libraries costs every start
-// of the binary a fifth of a second.
+// Input and output: 16-bit single-channel PNG files — the session format's depth frames (SPEC
+// section 3) — read and written with libpng; reading takes the faster libdeflate path of
+// png16_decode.h when it can. Not OpenCV's imgcodecs: on Debian it links GDAL, and loading its
+// libraries costs every start of the binary a fifth of a second.
 
 #include <filesystem>
 

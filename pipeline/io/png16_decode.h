@@ -1,7 +1,7 @@
 #pragma once
-// The fast path of ReadPng16 (png16.h): a 16-bit greyscale, non-interlaced PNG decoded from
-// memory with libdeflate, which inflates depth frames about 2.5x faster than zlib (inflating is
-// most of the cost of loading a session). Everything else is left to libpng.
+// Input and output: The fast path of ReadPng16 (png16.h): a 16-bit greyscale, non-interlaced PNG
+// decoded from memory with libdeflate, which inflates depth frames about 2.5x faster than zlib
+// (inflating is most of the cost of loading a session). Everything else is left to libpng.
 
 #include <cstddef>
 #include <cstdint>

@@ -1,6 +1,6 @@
 #pragma once
-// A capture session (SPEC section 3, format "boxd.session/1"): the camera, the calibration the
-// station used, and the raw depth frames of every turntable pose.
+// Input and output: A capture session (SPEC section 3, format "boxd.session/1"): the camera, the
+// calibration the station used, and the raw depth frames of every turntable pose.
 
 #include <filesystem>
 #include <optional>

@@ -1,5 +1,6 @@
 #pragma once
-// Reading and writing sessions in the boxd.session/1 folder format (SPEC section 3).
+// Input and output: Reading and writing sessions in the boxd.session/1 folder format (SPEC section
+// 3).
 
 #include <filesystem>
 

@@ -1,7 +1,7 @@
 #pragma once
-// The JSON form of the station calibration: the `calibration` block of SPEC section 3, written and
-// read here only (session.json, the daemon's calibration file, `boxd calibrate`'s report). The
-// YAML config reader and the YAML calibration file use the same keys.
+// Input and output: The JSON form of the station calibration: the `calibration` block of SPEC
+// section 3, written and read here only (session.json, the daemon's calibration file, `boxd
+// calibrate`'s report). The YAML config reader and the YAML calibration file use the same keys.
 
 #include <nlohmann/json_fwd.hpp>
 #include <string>

@@ -1,7 +1,7 @@
 #pragma once
-// The pose graph's residuals linearised at its solution, and what is read from them: the poses'
-// covariance (PoseCovariance, pose_graph.h) and the re-solve with each source weighed by its
-// variance component. Shared by pose_graph.cpp and pose_graph_variance.cpp only.
+// Registration stage: the pose graph's residuals linearised at its solution, and what is read from
+// them: the poses' covariance (PoseCovariance, pose_graph.h) and the re-solve with each source
+// weighed by its variance component. Shared by pose_graph.cpp and pose_graph_variance.cpp only.
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>

@@ -1,6 +1,6 @@
 #pragma once
-// What the rounding of recorded depths leaves in a horizontal surface's height, shared by every
-// view.
+// Views stage: what the rounding of recorded depths leaves in a horizontal surface's height, shared
+// by every view.
 //
 // Method. A camera records each depth rounded to its unit u (1 mm, 0.1 mm): a reading of a
 // surface at depth z is off by the sawtooth e(z) = u round(z / u) - z, smoothed by the noise

@@ -181,7 +181,7 @@ void AddBlock(FusedCloud& cloud, double x0, double x1, double y0, double y1, dou
 TEST(CheckSingleObject, OneBlockIsOneObject) {
     FusedCloud cloud;
     AddBlock(cloud, -0.15, 0.15, -0.1, 0.1, 0.2);
-    EXPECT_FALSE(CheckSingleObject(cloud, RefusalConfig{}).has_value());
+    EXPECT_FALSE(CheckSingleObject(cloud, cloud.table, RefusalConfig{}).has_value());
 }
 
 TEST(CheckSingleObject, TwoSeparateBlocksAreMultipleObjects) {
@@ -189,7 +189,7 @@ TEST(CheckSingleObject, TwoSeparateBlocksAreMultipleObjects) {
     FusedCloud cloud;
     AddBlock(cloud, -0.2, 0.1, -0.1, 0.1, 0.2);
     AddBlock(cloud, 0.15, 0.3, -0.05, 0.05, 0.15);
-    auto why = CheckSingleObject(cloud, RefusalConfig{});
+    auto why = CheckSingleObject(cloud, cloud.table, RefusalConfig{});
     ASSERT_TRUE(why.has_value());
     EXPECT_EQ(why->code, ErrorCode::kMultipleObjects);
     EXPECT_NE(why->message.find("2 separate objects"), std::string::npos) << why->message;
@@ -198,7 +198,7 @@ TEST(CheckSingleObject, TwoSeparateBlocksAreMultipleObjects) {
     FusedCloud touching;
     AddBlock(touching, -0.2, 0.1, -0.1, 0.1, 0.2);
     AddBlock(touching, 0.1, 0.25, -0.05, 0.05, 0.15);
-    EXPECT_FALSE(CheckSingleObject(touching, RefusalConfig{}).has_value());
+    EXPECT_FALSE(CheckSingleObject(touching, touching.table, RefusalConfig{}).has_value());
 }
 
 TEST(CheckSingleObject, ASpeckBelowTheMinimumShareIsNotAnObject) {
@@ -208,17 +208,17 @@ TEST(CheckSingleObject, ASpeckBelowTheMinimumShareIsNotAnObject) {
     FusedCloud cloud;
     AddBlock(cloud, -0.15, 0.15, -0.1, 0.1, 0.2);
     AddBlock(cloud, 0.19, 0.21, -0.01, 0.01, 0.05);
-    EXPECT_FALSE(CheckSingleObject(cloud, refuse).has_value());
+    EXPECT_FALSE(CheckSingleObject(cloud, cloud.table, refuse).has_value());
     // Points lower than two cells (2 cm) are table, not footprint: a flat scrap is no object
     // however large.
     FusedCloud flat;
     AddBlock(flat, -0.15, 0.15, -0.1, 0.1, 0.2);
     AddBlock(flat, 0.2, 0.35, -0.1, 0.1, 0.015);
-    EXPECT_FALSE(CheckSingleObject(flat, refuse).has_value());
+    EXPECT_FALSE(CheckSingleObject(flat, flat.table, refuse).has_value());
     // The same speck counts where the share is lowered below it.
     RefusalConfig strict = refuse;
     strict.min_object_share = 0.001;
-    auto why = CheckSingleObject(cloud, strict);
+    auto why = CheckSingleObject(cloud, cloud.table, strict);
     ASSERT_TRUE(why.has_value());
     EXPECT_EQ(why->code, ErrorCode::kMultipleObjects);
 }
@@ -236,7 +236,14 @@ TEST(CheckSingleObject, LoneReadingsInTheGapDoNotJoinTwoParcels) {
         cloud.view.push_back(0);
         cloud.view.push_back(0);
     }
-    auto why = CheckSingleObject(cloud, RefusalConfig{});
+    // The views that look down the gap read the table along it.
+    Points table;
+    for (double y = -0.1; y <= 0.1; y += 0.0025) {
+        for (double x = -0.01; x <= 0.01; x += 0.0025) {
+            table.emplace_back(static_cast<float>(x), static_cast<float>(y), 0.0f);
+        }
+    }
+    auto why = CheckSingleObject(cloud, table, RefusalConfig{});
     ASSERT_TRUE(why.has_value());
     EXPECT_EQ(why->code, ErrorCode::kMultipleObjects);
 
@@ -249,7 +256,7 @@ TEST(CheckSingleObject, LoneReadingsInTheGapDoNotJoinTwoParcels) {
             sparse.view.push_back(0);
         }
     }
-    EXPECT_FALSE(CheckSingleObject(sparse, RefusalConfig{}).has_value());
+    EXPECT_FALSE(CheckSingleObject(sparse, sparse.table, RefusalConfig{}).has_value());
 }
 
 EnclosingCuboid Cuboid(double l, double w, double h, bool cuboid) {

@@ -1,6 +1,6 @@
 #pragma once
 // Hand-made fused clouds for the enclosing cuboid's known-answer tests
-// (tests/pipeline/enclosing_cuboid_test.cpp, envelope_features_test.cpp).
+// (tests/pipeline/envelope/enclosing_cuboid_test.cpp, envelope_features_test.cpp).
 //
 // The clouds mimic a turntable session: kViews cameras round the object, each sampling every
 // surface that faces it (within 75 degrees of its normal; the top faces all of them) on its own

@@ -10,8 +10,19 @@
 namespace boxd {
 namespace {
 
-constexpr double kLink = 0.01;
-constexpr double kStray = 1.0 / 8.0;
+// 1 cm links, 2.8 cm across table nothing read.
+const FootprintLinks kLinks{0.02, 0.01, 0.028, 1.0 / 8.0};
+
+// Table readings every 2.5 mm over x in [x0, x1], y in [y0, y1].
+Points TableBetween(double x0, double x1, double y0, double y1) {
+    Points t;
+    for (double x = x0; x <= x1; x += 0.0025) {
+        for (double y = y0; y <= y1; y += 0.0025) {
+            t.emplace_back(static_cast<float>(x), static_cast<float>(y), 0.0f);
+        }
+    }
+    return t;
+}
 
 // A block's top (every `step`) and its four walls (every `step` up them), x in [x0, x1].
 void AddBlock(Points& pts, double x0, double x1, double y0, double y1, double h,
@@ -54,7 +65,7 @@ int Objects(const FootprintParts& parts, double share = 0.05) {
 TEST(SeparateFootprint, OneBlockIsOnePart) {
     Points pts;
     AddBlock(pts, -0.15, 0.15, -0.1, 0.1, 0.2);
-    const FootprintParts parts = SeparateFootprint(pts, 0.02, kLink, kStray);
+    const FootprintParts parts = SeparateFootprint(pts, {}, kLinks);
     EXPECT_EQ(parts.area_m2.size(), 1U);
     EXPECT_NEAR(parts.total_m2, 0.3 * 0.2, 0.3 * 0.2 * 0.15);
 }
@@ -62,7 +73,8 @@ TEST(SeparateFootprint, OneBlockIsOnePart) {
 TEST(SeparateFootprint, ParcelsApartAreTwoWhereverTheGridCuts) {
     // Two parcels 22 mm apart whose inner walls' readings spread 4 mm into the gap: 14 mm that
     // no reading crosses. The gap is slid across the cells of a 1 cm grid; every position is two
-    // parts (on 8-connected cells several positions joined them).
+    // parts (on 8-connected cells several positions joined them). Without the table read between
+    // them, the gap is unknown, and they are one part.
     for (double shift = 0.0; shift < 0.01; shift += 0.001) {
         std::mt19937 rng(7);
         Points pts;
@@ -71,25 +83,35 @@ TEST(SeparateFootprint, ParcelsApartAreTwoWhereverTheGridCuts) {
         AddBlock(pts, b, 0.15 + shift, -0.05, 0.06, 0.22);
         AddSpreadWall(pts, a, -0.07, 0.06, 0.27, 0.004, +1.0, rng);
         AddSpreadWall(pts, b, -0.05, 0.06, 0.22, 0.004, -1.0, rng);
-        const FootprintParts parts = SeparateFootprint(pts, 0.02, kLink, kStray);
+        // The table read along the gap, up to the walls' readings.
+        const Points table = TableBetween(a, b, -0.07, 0.06);
+        const FootprintParts parts = SeparateFootprint(pts, table, kLinks);
         EXPECT_EQ(Objects(parts), 2) << "shift " << shift;
+        EXPECT_EQ(Objects(SeparateFootprint(pts, {}, kLinks)), 1) << "shift " << shift;
     }
 }
 
 TEST(SeparateFootprint, ParcelsCloserThanTheLinkAreOne) {
-    // 8 mm of free table between them is less than the link: the readings cannot tell two
+    // 8 mm of table read free between them is less than the link: the readings cannot tell two
     // parcels from one with a groove, and they are one part (the cuboid encloses both).
     Points pts;
     AddBlock(pts, -0.16, -0.004, -0.07, 0.06, 0.27);
     AddBlock(pts, 0.004, 0.15, -0.05, 0.06, 0.22);
-    EXPECT_EQ(Objects(SeparateFootprint(pts, 0.02, kLink, kStray)), 1);
+    EXPECT_EQ(Objects(SeparateFootprint(pts, TableBetween(-0.004, 0.004, -0.07, 0.06), kLinks)), 1);
+}
+
+TEST(SeparateFootprint, ParcelsFartherApartThanTheUnreadReachAreTwo) {
+    // 4 cm apart with nothing read between them: farther than unread table may join.
+    Points pts;
+    AddBlock(pts, -0.16, -0.02, -0.07, 0.06, 0.27);
+    AddBlock(pts, 0.02, 0.15, -0.05, 0.06, 0.22);
+    EXPECT_EQ(Objects(SeparateFootprint(pts, {}, kLinks)), 2);
 }
 
 TEST(SeparateFootprint, ASparselyReadTopStaysOnePart) {
     // A top read in clusters 14 mm apart (a flat carton from four poses and a low camera: one
-    // cluster of three readings every 14 mm), wider apart than the 1 cm link: each cluster's cell
-    // holds two or three readings, so its readings link as far as their spacing stretched along
-    // the view, and the top is one part.
+    // cluster of three readings every 14 mm), wider apart than the 1 cm link, and no view saw
+    // the table under it: one part.
     Points pts;
     for (double x = -0.12; x <= 0.12; x += 0.014) {
         for (double y = -0.08; y <= 0.08; y += 0.014) {
@@ -98,7 +120,7 @@ TEST(SeparateFootprint, ASparselyReadTopStaysOnePart) {
             }
         }
     }
-    EXPECT_EQ(Objects(SeparateFootprint(pts, 0.02, kLink, kStray)), 1);
+    EXPECT_EQ(Objects(SeparateFootprint(pts, {}, kLinks)), 1);
 }
 
 TEST(SeparateFootprint, LowReadingsAndLoneStraysAreNoPart) {
@@ -108,7 +130,7 @@ TEST(SeparateFootprint, LowReadingsAndLoneStraysAreNoPart) {
     // Lone readings every 2 cm along a line 2 cm beside the block: each its own edge cell.
     for (double y = -0.09; y <= 0.09; y += 0.02)
         pts.emplace_back(0.17f, static_cast<float>(y), 0.1f);
-    const FootprintParts parts = SeparateFootprint(pts, 0.02, kLink, kStray);
+    const FootprintParts parts = SeparateFootprint(pts, {}, kLinks);
     EXPECT_EQ(parts.area_m2.size(), 1U);
 }
 
