@@ -12,6 +12,7 @@
 #include "pipeline/frames/prepare_pose.h"
 #include "pipeline/refusal.h"
 #include "pipeline/registration/register_views.h"
+#include "pipeline/view_stream.h"
 #include "pipeline/views/object_views.h"
 #include "pipeline/views/table_plane.h"
 
@@ -61,31 +62,36 @@ Error AsCalibrationRefusal(const MeasurementReason& why) {
 // A centre the calibration knows nothing of, as a sigma: a metre, beyond any table.
 constexpr double kUnknownCenterSigmaM = 1.0;
 
-// The measurement recipe's stages 1 to 6 with the recorded calibration (the same calls, the
-// same refusal rules), then the origin moved to the turntable centre the registered views
-// rotate about.
+// The measurement recipe's stages 1 to 6 with the recorded calibration (the same stream, the same
+// refusal rules), then the origin moved to the turntable centre the registered views rotate
+// about. The depths stay for the joint problem.
 Result<InitialEstimate> EstimateInitial(const Session& session, const MeasureConfig& mc) {
     InitialEstimate est;
     auto depths = UsableDepths(PrepareSession(session, mc.Frames()), mc.refusal);
     if (!depths) return Error{ErrorCode::kTableNotVisible, depths.error().message};
     est.depths = std::move(*depths);
-    auto table = FitTablePlane(est.depths, session.camera, session.calibration, mc.table_plane);
-    if (!table) {
-        return Error{
-            ErrorCode::kTableNotVisible,
-            "the table top around the reference box is not visible: " + table.error().message};
+    ViewStream stream(session, session.PoseAnglesDeg(), mc);
+    std::vector<PreparedPose> poses;
+    for (const DepthMap& d : est.depths) poses.push_back(PreparedPose{d, {}});
+    stream.AddAll(std::move(poses));
+    if (auto why = stream.Complete()) {
+        if (!stream.TableFound()) {
+            return Error{ErrorCode::kTableNotVisible,
+                         "the table top around the reference box is not visible: " + why->message};
+        }
+        return AsCalibrationRefusal(*why);
     }
-    ObjectViews views = SegmentObjectViews(
-        est.depths, session.camera, session.calibration, table->camera_to_table, mc.segmentation,
-        mc.registration.coarse_cloud, mc.registration.fine_cloud, mc.threads);
-    if (auto why = CheckObjectViews(views, mc.refusal)) return AsCalibrationRefusal(*why);
+    const TablePlaneFit& table = stream.table();
+    ObjectViews& views = stream.views();
 
     const int n = static_cast<int>(session.poses.size());
     // The recorded centre is what the calibration finds: the solve takes no word from it.
     PoseGraphConfig graph = mc.pose_graph;
     graph.calibration_center_sigma_m = kUnknownCenterSigmaM;
+    EdgeStats stats;
+    std::vector<PoseEdge> edges = stream.Edges(&stats);
     auto registered =
-        RegisterViews(views.clouds, session.PoseAnglesRad(), mc.registration, graph, nullptr);
+        SolveViewGraph(std::move(edges), stats, session.PoseAnglesRad(), graph, nullptr);
     if (!registered) return AsCalibrationRefusal(registered.error());
     if (auto why = CheckRegisteredViews(*registered, n, mc.refusal)) {
         return AsCalibrationRefusal(*why);
@@ -102,13 +108,13 @@ Result<InitialEstimate> EstimateInitial(const Session& session, const MeasureCon
         view_points[k] = std::move(views.views[k].fusion_points);
     }
     const FusedFit fit = FuseAndFit(view_points, registered->poses, mc.fusion, mc.box_fit, nullptr,
-                                    table->camera_to_table.translation().cast<float>());
+                                    table.camera_to_table.translation().cast<float>());
     if (auto why = CheckFusedFit(fit, mc.refusal)) return AsCalibrationRefusal(*why);
 
     // Move the origin to the centre: registered motions become rotations about the origin.
     Eigen::Isometry3d shift = Eigen::Isometry3d::Identity();
     shift.translation() = Eigen::Vector3d(-centre->center.x(), -centre->center.y(), 0.0);
-    est.camera_to_table = shift * table->camera_to_table;
+    est.camera_to_table = shift * table.camera_to_table;
     for (const Se2& p : registered->poses) {
         est.poses.push_back(Se2::RotationAbout(p.yaw, Eigen::Vector2d::Zero()));
     }

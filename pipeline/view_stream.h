@@ -68,6 +68,8 @@ public:
     // After Complete: the table fit, the views, the accepted edges (in the refitted frame) with
     // their statistics.
     const TablePlaneFit& table() const { return table_; }
+    // After Complete: whether the table top was found (a refusal before it is the table's).
+    bool TableFound() const { return completed_ && !table_error_; }
     ObjectViews& views() { return views_; }
     std::vector<PoseEdge> Edges(EdgeStats* stats) const;
     // Time spent in Add / AddAll: the table and the views, and the alignments.
