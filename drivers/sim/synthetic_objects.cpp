@@ -1,8 +1,13 @@
 #include "drivers/sim/synthetic_objects.h"
 
+#include <spdlog/fmt/fmt.h>
+#include <spdlog/fmt/ranges.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "drivers/sim/shape_meshes.h"
 
@@ -78,10 +83,10 @@ Result<SyntheticShape> ParseSyntheticShape(const std::string& name) {
     for (const auto& s : kShapeNames) {
         if (name == s.name) return s.shape;
     }
-    std::string names;
-    for (const auto& s : kShapeNames) names += std::string(names.empty() ? "" : ", ") + s.name;
+    std::vector<std::string> names;
+    for (const auto& s : kShapeNames) names.emplace_back(s.name);
     return Error{ErrorCode::kInvalidInput,
-                 "shape: must be one of " + names + ", got '" + name + "'"};
+                 fmt::format("shape: must be one of {}, got '{}'", fmt::join(names, ", "), name)};
 }
 
 Status ValidateSyntheticObject(const SyntheticBox& b, const std::string& field) {
