@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <numeric>
 #include <unordered_map>
-#include <unordered_set>
 #include <utility>
 
 #include "pipeline/core/median.h"
@@ -22,60 +21,134 @@ std::int64_t Key(int x, int y) {
 
 int Index(double v, double inv) { return static_cast<int>(std::floor(v * inv)); }
 
+// Readings closer than this across the table are one place to the links.
+constexpr double kDistinctM = 0.001;
+
+// A square grid of `cell_m` over the box [lo, hi], a T a cell.
+template <typename T>
+class Raster {
+public:
+    Raster(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, double cell_m)
+        : lo_(lo), inv_(1.0 / cell_m) {
+        nx_ = static_cast<int>(std::ceil((hi.x() - lo.x()) * inv_)) + 1;
+        ny_ = static_cast<int>(std::ceil((hi.y() - lo.y()) * inv_)) + 1;
+        cells_.assign(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_), 0);
+    }
+
+    // The cell of p, or nullptr outside the box.
+    T* At(const Eigen::Vector2d& p) {
+        const long k = Offset(p);
+        return k < 0 ? nullptr : &cells_[static_cast<std::size_t>(k)];
+    }
+    // The value of the cell of p, 0 outside the box.
+    T Get(const Eigen::Vector2d& p) const {
+        const long k = Offset(p);
+        return k < 0 ? 0 : cells_[static_cast<std::size_t>(k)];
+    }
+
+private:
+    long Offset(const Eigen::Vector2d& p) const {
+        const int x = Index(p.x() - lo_.x(), inv_), y = Index(p.y() - lo_.y(), inv_);
+        if (x < 0 || y < 0 || x >= nx_ || y >= ny_) return -1;
+        return static_cast<long>(y) * nx_ + x;
+    }
+
+    Eigen::Vector2d lo_;
+    double inv_;
+    int nx_ = 0, ny_ = 0;
+    std::vector<T> cells_;
+};
+
+// The box of `xy` grown by `margin`.
+std::pair<Eigen::Vector2d, Eigen::Vector2d> Bounds(const Flat& xy, double margin) {
+    Eigen::Vector2d lo = Eigen::Vector2d::Constant(INFINITY), hi = -lo;
+    for (const Eigen::Vector2f& p : xy) {
+        lo = lo.cwiseMin(p.cast<double>());
+        hi = hi.cwiseMax(p.cast<double>());
+    }
+    return {lo.array() - margin, hi.array() + margin};
+}
+
 // The footprint without the lone readings at its edge (footprint_parts.h).
 Flat WithoutStrays(const Flat& xy, double cell_m, double stray_share) {
-    const double inv = 1.0 / cell_m;
-    std::unordered_map<std::int64_t, int> count;
-    for (const Eigen::Vector2f& p : xy) ++count[Key(Index(p.x(), inv), Index(p.y(), inv))];
+    if (xy.empty()) return xy;
+    const auto [lo, hi] = Bounds(xy, 2.0 * cell_m);
+    Raster<int> count(lo, hi, cell_m);
+    for (const Eigen::Vector2f& p : xy) ++*count.At(p.cast<double>());
     std::vector<double> counts;
-    counts.reserve(count.size());
-    for (const auto& [key, n] : count) counts.push_back(n);
+    for (const Eigen::Vector2f& p : xy) {
+        // Each occupied cell's count once: at its first reading, marked by the sign.
+        int* c = count.At(p.cast<double>());
+        if (*c > 0) {
+            counts.push_back(*c);
+            *c = -*c;
+        }
+    }
     const double stray = stray_share * Median(std::move(counts));
-    auto occupied = [&](int x, int y) { return count.count(Key(x, y)) > 0; };
+    auto occupied = [&](const Eigen::Vector2d& q) { return count.Get(q) != 0; };
     Flat kept;
     kept.reserve(xy.size());
     for (const Eigen::Vector2f& p : xy) {
-        const int x = Index(p.x(), inv), y = Index(p.y(), inv);
-        const bool edge = !occupied(x + 1, y) || !occupied(x - 1, y) || !occupied(x, y + 1) ||
-                          !occupied(x, y - 1);
-        if (!(edge && count[Key(x, y)] < stray)) kept.push_back(p);
+        const Eigen::Vector2d q = p.cast<double>();
+        const bool edge = !occupied(q + Eigen::Vector2d(cell_m, 0.0)) ||
+                          !occupied(q - Eigen::Vector2d(cell_m, 0.0)) ||
+                          !occupied(q + Eigen::Vector2d(0.0, cell_m)) ||
+                          !occupied(q - Eigen::Vector2d(0.0, cell_m));
+        if (!(edge && -count.Get(q) < stray)) kept.push_back(p);
     }
     return kept;
 }
 
-// Where the table was read and nothing of the object: cells of `cell_m` holding a table reading
-// and no footprint reading. A segment crossing one crosses seen free table.
+// One reading per `cell_m` square: the footprint of a wall holds its readings of every height at
+// one place, and the links need each place once (a millimetre moves no link of a centimetre).
+Flat Distinct(const Flat& xy, double cell_m) {
+    if (xy.empty()) return xy;
+    const auto [lo, hi] = Bounds(xy, 0.0);
+    Raster<std::uint8_t> seen(lo, hi, cell_m);
+    Flat out;
+    for (const Eigen::Vector2f& p : xy) {
+        std::uint8_t* c = seen.At(p.cast<double>());
+        if (c && !*c) {
+            *c = 1;
+            out.push_back(p);
+        }
+    }
+    return out;
+}
+
+// Where the table was read and nothing of the object, over the footprint grown by `reach`:
+// cells of `cell_m` holding a table reading and no footprint reading. A segment crossing one
+// crosses seen free table.
 class FreeTable {
 public:
-    FreeTable(const Points& table, const Flat& footprint, double cell_m) : inv_(1.0 / cell_m) {
-        std::unordered_set<std::int64_t> object;
-        for (const Eigen::Vector2f& p : footprint) object.insert(KeyOf(p.cast<double>()));
+    FreeTable(const Points& table, const Flat& footprint, double cell_m, double reach)
+        : raster_(Bounds(footprint, reach).first, Bounds(footprint, reach).second, cell_m),
+          step_(0.5 * cell_m) {
+        constexpr std::uint8_t kTable = 1, kObject = 2;
         for (const Eigen::Vector3f& t : table) {
-            const std::int64_t key = KeyOf(t.head<2>().cast<double>());
-            if (!object.count(key)) free_.insert(key);
+            if (std::uint8_t* c = raster_.At(t.head<2>().cast<double>())) *c |= kTable;
         }
-        step_ = 0.5 * cell_m;
+        for (const Eigen::Vector2f& p : footprint) {
+            if (std::uint8_t* c = raster_.At(p.cast<double>())) *c |= kObject;
+        }
+        any_ = !table.empty();
     }
 
     // Whether the segment from a to b crosses a free cell.
     bool Crosses(const Eigen::Vector2d& a, const Eigen::Vector2d& b) const {
-        if (free_.empty()) return false;
-        const double length = (b - a).norm();
-        const int steps = static_cast<int>(std::ceil(length / step_));
+        if (!any_) return false;
+        const int steps = static_cast<int>(std::ceil((b - a).norm() / step_));
         for (int i = 0; i <= steps; ++i) {
             const double t = steps > 0 ? static_cast<double>(i) / steps : 0.0;
-            if (free_.count(KeyOf(a + t * (b - a)))) return true;
+            if (raster_.Get(a + t * (b - a)) == 1) return true;  // table and no object
         }
         return false;
     }
 
 private:
-    std::int64_t KeyOf(const Eigen::Vector2d& p) const {
-        return Key(Index(p.x(), inv_), Index(p.y(), inv_));
-    }
-
-    double inv_, step_ = 0.0;
-    std::unordered_set<std::int64_t> free_;
+    Raster<std::uint8_t> raster_;
+    double step_;
+    bool any_ = false;
 };
 
 // The readings sorted into square cells whose diagonal is the link (any two readings of one cell
@@ -194,8 +267,8 @@ FootprintParts SeparateFootprint(const Points& points, const Points& table,
     for (const Eigen::Vector3f& p : points) {
         if (p.z() >= links.min_height_m) xy.emplace_back(p.x(), p.y());
     }
-    xy = WithoutStrays(xy, links.link_m, links.stray_share);
-    const FreeTable free(table, xy, 0.5 * links.link_m);
+    xy = Distinct(WithoutStrays(xy, links.link_m, links.stray_share), kDistinctM);
+    const FreeTable free(table, xy, 0.5 * links.link_m, links.unread_reach_m);
     LinkGrid grid(std::move(xy), links.link_m);
     grid.Link();
     grid.Bridge(free, links.unread_reach_m);
