@@ -100,6 +100,31 @@ void AddTableReadings(ObjectViews& views, const std::vector<Se2>& poses, FusedCl
     fused->table_known = true;
 }
 
+// Stages 5 and 6 on the registered views: their points fused (a single view's at full density)
+// and the box fits, with the table's readings beside the object (several views).
+FusedFit FuseRegistered(ObjectViews& views, const RegisteredViews& registered,
+                        const TablePlaneFit& table, const MeasureConfig& config, StageLaps* laps) {
+    const bool single = views.views.size() == 1;
+    std::vector<Points> view_points(views.views.size());
+    for (std::size_t k = 0; k < view_points.size(); ++k) {
+        view_points[k] =
+            single ? std::move(views.views[k].points) : std::move(views.views[k].fusion_points);
+    }
+    FusedFit fit = FuseAndFit(view_points, registered.poses, config.fusion, config.box_fit, laps,
+                              table.camera_to_table.translation().cast<float>());
+    if (!single) AddTableReadings(views, registered.poses, &fit.fused);
+    return fit;
+}
+
+// The envelope's figures the result's quality block reports.
+void FillQuality(const EnclosingCuboid& cuboid, MeasurementQuality* quality) {
+    quality->footprint_fill = cuboid.fill;
+    quality->top_cover = cuboid.top_cover;
+    quality->face_excess_ratio = cuboid.max_relative_excess;
+    quality->cuboid_assumed = cuboid.assumed;
+    if (std::isfinite(cuboid.flatness)) quality->face_flatness = cuboid.flatness;
+}
+
 // Stages 4b to 7 on the views and edges of `stream`.
 MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const MeasureConfig& config,
                            BoxMethod method, const MonotonicMs& clock) {
@@ -125,15 +150,8 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
     if (auto why = CheckRegisteredViews(*registered, n, refuse)) return m.Refused(*why);
 
     // 5, 6. Fusion and the box fits.
-    std::vector<Points> view_points(views.views.size());
-    for (std::size_t k = 0; k < view_points.size(); ++k) {
-        view_points[k] =
-            n == 1 ? std::move(views.views[k].points) : std::move(views.views[k].fusion_points);
-    }
-    FusedFit fit = FuseAndFit(view_points, registered->poses, config.fusion, config.box_fit,
-                              &m.laps, table.camera_to_table.translation().cast<float>());
+    FusedFit fit = FuseRegistered(views, *registered, table, config, &m.laps);
     quality.points = static_cast<long>(fit.fused.points.size());
-    if (n > 1) AddTableReadings(views, registered->poses, &fit.fused);
     const Points& table_read = n > 1 ? fit.fused.table : views.views[0].table_points;
     if (auto why = CheckSingleObject(fit.fused, table_read, refuse)) {
         m.out.cloud = std::move(fit.fused.points);
@@ -149,11 +167,7 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
     m.laps.Lap("fit");
     std::array<double, 3> uncertainty{};
     if (cuboid) {
-        quality.footprint_fill = cuboid->fill;
-        quality.top_cover = cuboid->top_cover;
-        quality.face_excess_ratio = cuboid->max_relative_excess;
-        quality.cuboid_assumed = cuboid->assumed;
-        if (std::isfinite(cuboid->flatness)) quality.face_flatness = cuboid->flatness;
+        FillQuality(*cuboid, &quality);
         const BoundSettings settings{session.camera.depth_unit_m, config.box_fit.min_band_m,
                                      config.envelope.edge_margin_m};
         uncertainty = CuboidBounds95(fit, *cuboid, *registered, table, session.calibration,
