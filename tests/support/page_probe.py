@@ -99,6 +99,13 @@ class Chromium:
         return False
 
 
+# The canvas fills the view again at the window width given, the cloud drawn on it.
+FITTED = ("(() => { const c = document.querySelector('#view canvas'); "
+          "const v = document.getElementById('view').getBoundingClientRect(); "
+          "return window.innerWidth === %d && c !== null && Math.abs(c.clientWidth - v.width) <= 1 "
+          "&& Math.abs(c.clientHeight - v.height) <= 1 && +c.dataset.litPixels > 500; })()")
+
+
 def screenshot(browser, path):
     metrics = browser.call("Page.getLayoutMetrics")["cssContentSize"]
     shot = browser.call("Page.captureScreenshot", format="png", captureBeyondViewport=True,
@@ -122,7 +129,9 @@ def main():
     browser = Chromium()
     target = browser.call("Target.createTarget", url="about:blank")["targetId"]
     browser.session = browser.call("Target.attachToTarget", targetId=target, flatten=True)["sessionId"]
-    drawn = "(document.querySelector('#view canvas') || {dataset: {}}).dataset.litPixels"
+    # The cloud drawn: a canvas with more lit pixels than its background's edges (a "0" from a
+    # draw before the canvas had its size is not drawn yet).
+    drawn = "+((document.querySelector('#view canvas') || {dataset: {}}).dataset.litPixels || 0) > 500"
     for n, step in enumerate(steps):
         result = {"step": step}
         if step[0].isdigit():
@@ -132,7 +141,10 @@ def main():
             result["drawn"] = browser.wait_for(drawn)
         elif step.startswith("resize:"):
             size(browser, step[len("resize:"):])
-            time.sleep(1.0)  # the ResizeObserver redraws
+            # The ResizeObserver redraws: until the canvas has the view's new size and the cloud
+            # is drawn on it (a loaded machine takes longer than any fixed pause).
+            result["redrawn"] = browser.wait_for(FITTED % int(step.split(":")[1].split("x")[0]), 15)
+            time.sleep(0.3)
         elif step == "measure":
             before = browser.evaluate("document.getElementById('last-id').textContent")
             browser.evaluate("document.getElementById('measure').click()")
