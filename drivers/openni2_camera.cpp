@@ -1,4 +1,3 @@
-// The OpenNI2 depth camera.
 #include "drivers/openni2_camera.h"
 
 #include <OpenNI.h>
@@ -209,10 +208,8 @@ Result<CameraIntrinsics> OpenNi2Camera::Impl::Intrinsics(const openni::VideoMode
                                std::to_string(override_intrinsics->height) + " but the stream is " +
                                std::to_string(k.width) + "x" + std::to_string(k.height));
         }
-        k.fx = override_intrinsics->fx;
-        k.fy = override_intrinsics->fy;
-        k.cx = override_intrinsics->cx;
-        k.cy = override_intrinsics->cy;
+        k = *override_intrinsics;  // its size is the stream's: only the depth unit is the device's
+        k.depth_unit_m = depth_unit_m;
     } else {
         const double hfov = stream.getHorizontalFieldOfView();
         const double vfov = stream.getVerticalFieldOfView();
