@@ -28,6 +28,8 @@ constexpr double kDistinctM = 0.001;
 template <typename T>
 class Raster {
 public:
+    Raster(const std::pair<Eigen::Vector2d, Eigen::Vector2d>& box, double cell_m)
+        : Raster(box.first, box.second, cell_m) {}
     Raster(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, double cell_m)
         : lo_(lo), inv_(1.0 / cell_m) {
         nx_ = static_cast<int>(std::ceil((hi.x() - lo.x()) * inv_)) + 1;
@@ -122,8 +124,7 @@ Flat Distinct(const Flat& xy, double cell_m) {
 class FreeTable {
 public:
     FreeTable(const Points& table, const Flat& footprint, double cell_m, double reach)
-        : raster_(Bounds(footprint, reach).first, Bounds(footprint, reach).second, cell_m),
-          step_(0.5 * cell_m) {
+        : raster_(Bounds(footprint, reach), cell_m), step_(0.5 * cell_m) {
         constexpr std::uint8_t kTable = 1, kObject = 2;
         for (const Eigen::Vector3f& t : table) {
             if (std::uint8_t* c = raster_.At(t.head<2>().cast<double>())) *c |= kTable;
@@ -268,6 +269,7 @@ FootprintParts SeparateFootprint(const Points& points, const Points& table,
         if (p.z() >= links.min_height_m) xy.emplace_back(p.x(), p.y());
     }
     xy = Distinct(WithoutStrays(xy, links.link_m, links.stray_share), kDistinctM);
+    if (xy.empty()) return {};  // nothing stands above the table
     const FreeTable free(table, xy, 0.5 * links.link_m, links.unread_reach_m);
     LinkGrid grid(std::move(xy), links.link_m);
     grid.Link();

@@ -123,6 +123,16 @@ TEST(SeparateFootprint, ASparselyReadTopStaysOnePart) {
     EXPECT_EQ(Objects(SeparateFootprint(pts, {}, kLinks)), 1);
 }
 
+TEST(SeparateFootprint, NothingAboveTheTableIsNoPart) {
+    // A carton 12 mm high, beside the table's readings: no footprint at all.
+    Points pts;
+    AddBlock(pts, -0.1, 0.1, -0.075, 0.075, 0.012);
+    const FootprintParts parts =
+        SeparateFootprint(pts, TableBetween(0.11, 0.15, -0.05, 0.05), kLinks);
+    EXPECT_TRUE(parts.area_m2.empty());
+    EXPECT_EQ(parts.total_m2, 0.0);
+}
+
 TEST(SeparateFootprint, LowReadingsAndLoneStraysAreNoPart) {
     Points pts;
     AddBlock(pts, -0.15, 0.15, -0.1, 0.1, 0.2);
