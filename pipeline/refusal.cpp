@@ -75,6 +75,9 @@ Status RefusalConfig::Validate() const {
     if (!(max_model_translation_deviation_m > 0.0)) {
         return bad("max_model_translation_deviation_m", "must be > 0");
     }
+    if (!(max_centre_disagreement_sigma > 0.0)) {
+        return bad("max_centre_disagreement_sigma", "must be > 0");
+    }
     if (!(max_face_sigma_m > 0.0)) return bad("max_face_sigma_m", "must be > 0");
     if (!(object_cell_m > 0.0 && object_cell_m < 0.1)) return bad("object_cell_m", "in (0, 0.1)");
     if (!(min_object_share > 0.0 && min_object_share < 0.5)) {
@@ -140,6 +143,14 @@ std::optional<MeasurementReason> CheckRegisteredViews(const RegisteredViews& reg
             ErrorCode::kRegistrationFailed,
             fmt::format("too few views could be registered ({} of {} unregistered)", unregistered,
                         poses)};
+    }
+    if (report.centre_disagreement > refuse.max_centre_disagreement_sigma) {
+        return MeasurementReason{
+            ErrorCode::kRegistrationFailed,
+            fmt::format("the views' alignments put the turntable's axis {:.1f} mm from where the "
+                        "calibration has it ({:.1f} sigma): the alignments or the calibration "
+                        "are wrong (re-scan; if it persists, recalibrate)",
+                        report.centre_offset_m * 1000.0, report.centre_disagreement)};
     }
     if (registered.edges.mean_rmse_m > refuse.max_registration_rmse_m) {
         return MeasurementReason{ErrorCode::kRegistrationFailed,

@@ -32,6 +32,11 @@ struct RefusalConfig {
     double max_rejected_edge_fraction = 0.2;
     double max_model_yaw_deviation_deg = 3.0;  // registered poses vs the turntable model ...
     double max_model_translation_deviation_m = 0.015;  // ... beyond these: OBJECT_MOVED
+    // The alignments' table centre farther from the calibrated one than this many standard
+    // deviations of their difference (PoseGraphReport::centre_disagreement): one of the two is
+    // wrong and the poses are not known. 5.26 sigma in two dimensions: one honest station in a
+    // million disagrees so far.
+    double max_centre_disagreement_sigma = 5.26;
     // Box faces rougher than this (robust sigma of the face fits) are not faces of one rigid box
     // seen from registered views.
     double max_face_sigma_m = 0.01;
@@ -55,7 +60,8 @@ std::optional<MeasurementReason> CheckObjectViews(const ObjectViews& views,
 // Registered views (of `poses` views; a single view is not judged): OBJECT_MOVED when the
 // registered poses leave the turntable model or too many alignments disagree with the rest (the
 // views show the object in two places), REGISTRATION_FAILED when too few views are registered
-// or the views do not align. A view whose alignments found no side in common with any view it
+// or the views do not align, or when their alignments put the turntable's axis where the
+// calibration says it is not (max_centre_disagreement_sigma). A view whose alignments found no side in common with any view it
 // was paired with, their tops matching (EdgeStats::tested_views), rests on the turntable model,
 // as views too far apart to pair do, and is not counted unregistered.
 std::optional<MeasurementReason> CheckRegisteredViews(const RegisteredViews& registered, int poses,

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <optional>
 #include <vector>
 
 #include "pipeline/core/result.h"
@@ -103,6 +104,11 @@ struct PoseGraphReport {
     double max_model_yaw_deviation_rad = 0.0;  // registered poses vs the turntable model
     double max_model_translation_deviation_m = 0.0;
     std::vector<int> unconstrained;  // the nodes without any kept edge
+    // The table's centre from the alignments against the calibration's (CentreDisagreement):
+    // its distance (metres) and in sigmas. Two measurements of one axis;
+    // far apart, one of them is wrong.
+    double centre_offset_m = 0.0;
+    double centre_disagreement = 0.0;
 };
 
 // Whether the alignments and the turntable prior of `graph`, without the edges' slides, at its
@@ -112,6 +118,17 @@ struct PoseGraphReport {
 // better, the centre comes from them (PoseGraph::centre_from_calibration); where they do not
 // (four views a quarter turn apart leave a direction free), the calibration is all there is.
 bool CalibrationCounts(const PoseGraph& graph, const PoseGraphConfig& config);
+
+// The information (inverse covariance, 2 x 2) the alignments and the turntable prior of `graph`,
+// without the edges' slides, give the table's centre at its poses (CalibrationCounts' Schur
+// complement); none where the graph cannot be linearised.
+std::optional<Eigen::Matrix2d> CentreInformation(const PoseGraph& graph,
+                                                 const PoseGraphConfig& config);
+
+// How far the alignments' centre of `graph` (its centre_offset, from the calibration's) lies
+// from the calibration's, in the standard deviations of their difference (the alignments' and
+// calibration_center_sigma_m together): sqrt(dᵀ Σ⁻¹ d). 0 where the centre is the calibration's.
+double CentreDisagreement(const PoseGraph& graph, const PoseGraphConfig& config);
 
 // Solves `graph` once with the edges not marked rejected; updates poses and centre offset.
 Status SolvePoseGraph(PoseGraph& graph, const PoseGraphConfig& config);

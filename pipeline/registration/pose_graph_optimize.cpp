@@ -74,8 +74,12 @@ Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfi
         graph.centre_from_calibration = true;
         if (Status s = RejectAndWeigh(graph, config, report, weighed); !s) return s.error();
     }
-    spdlog::debug("pose graph: the table's centre from the {}",
-                  graph.centre_from_calibration ? "calibration" : "alignments");
+    report.centre_disagreement = CentreDisagreement(graph, weighed);
+    report.centre_offset_m = graph.centre_from_calibration ? 0.0 : graph.center_offset.norm();
+    spdlog::debug("pose graph: the table's centre from the {}, {:.2f} mm from the calibration's "
+                  "({:.1f} sigma)",
+                  graph.centre_from_calibration ? "calibration" : "alignments",
+                  report.centre_offset_m * 1e3, report.centre_disagreement);
     std::vector<int> degree(graph.poses.size(), 0);
     for (const PoseEdge& e : graph.edges) {
         if (e.rejected) continue;

@@ -242,13 +242,13 @@ Eigen::MatrixXd PoseCovariance(const PoseGraph& graph, const PoseGraphConfig& co
     return cov;
 }
 
-bool CalibrationCounts(const PoseGraph& graph, const PoseGraphConfig& config) {
-    const int n = static_cast<int>(graph.poses.size());
-    if (n < 2) return true;
+std::optional<Eigen::Matrix2d> CentreInformation(const PoseGraph& graph,
+                                                 const PoseGraphConfig& config) {
+    if (graph.poses.size() < 2) return std::nullopt;
     PoseGraph without = graph;
     without.centre_from_calibration = false;
     const auto lin = pose_graph_internal::Linearize(without, config);
-    if (!lin) return true;
+    if (!lin) return std::nullopt;
     // The normal matrix's node block and its centre columns (the last two).
     const Eigen::SparseMatrix<double> normal =
         Eigen::SparseMatrix<double>(lin->jacobian.transpose()) * lin->jacobian;
@@ -256,16 +256,31 @@ bool CalibrationCounts(const PoseGraph& graph, const PoseGraphConfig& config) {
     const Eigen::SparseMatrix<double> nodes = normal.topLeftCorner(m, m);
     const Eigen::MatrixXd cross = Eigen::MatrixXd(normal.topRightCorner(m, 2));
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(nodes);
-    if (ldlt.info() != Eigen::Success) return true;
+    if (ldlt.info() != Eigen::Success) return std::nullopt;
     const Eigen::MatrixXd solved = ldlt.solve(cross);
-    if (ldlt.info() != Eigen::Success) return true;
-    const Eigen::Matrix2d centre =
-        Eigen::MatrixXd(normal.bottomRightCorner(2, 2)) - cross.transpose() * solved;
-    const double weakest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(centre).eigenvalues()(0);
+    if (ldlt.info() != Eigen::Success) return std::nullopt;
+    return Eigen::Matrix2d(Eigen::MatrixXd(normal.bottomRightCorner(2, 2)) -
+                           cross.transpose() * solved);
+}
+
+bool CalibrationCounts(const PoseGraph& graph, const PoseGraphConfig& config) {
+    const auto centre = CentreInformation(graph, config);
+    if (!centre) return true;
+    const double weakest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(*centre).eigenvalues()(0);
     const double s = config.calibration_center_sigma_m;
     spdlog::debug("pose graph: the alignments know the centre to {:.3f} mm at worst",
                   weakest > 0.0 ? 1e3 / std::sqrt(weakest) : INFINITY);
     return !(weakest > 1.0 / (s * s));
+}
+
+double CentreDisagreement(const PoseGraph& graph, const PoseGraphConfig& config) {
+    if (graph.centre_from_calibration) return 0.0;
+    const auto centre = CentreInformation(graph, config);
+    if (!centre) return 0.0;
+    const double s = config.calibration_center_sigma_m;
+    const Eigen::Matrix2d both = centre->inverse() + s * s * Eigen::Matrix2d::Identity();
+    const double d2 = graph.center_offset.dot(both.ldlt().solve(graph.center_offset));
+    return std::isfinite(d2) && d2 > 0.0 ? std::sqrt(d2) : 0.0;
 }
 
 namespace pose_graph_internal {

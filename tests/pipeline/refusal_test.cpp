@@ -83,6 +83,18 @@ TEST(CheckRegisteredViews, MovedObjectUnregisteredViewsAndPoorAlignment) {
     r.graph.max_model_translation_deviation_m = refuse.max_model_translation_deviation_m * 1.1;
     EXPECT_EQ(CheckRegisteredViews(r, 18, refuse)->code, ErrorCode::kObjectMoved);
 
+    // The alignments' centre of the table 8.8 mm and 7.1 sigmas from the calibration's: one of
+    // the two is wrong.
+    r = Registered(36, 0, 0.001);
+    r.graph.centre_offset_m = 0.0088;
+    r.graph.centre_disagreement = 7.1;
+    why = CheckRegisteredViews(r, 18, refuse);
+    ASSERT_TRUE(why.has_value());
+    EXPECT_EQ(why->code, ErrorCode::kRegistrationFailed);
+    EXPECT_NE(why->message.find("8.8 mm"), std::string::npos) << why->message;
+    r.graph.centre_disagreement = refuse.max_centre_disagreement_sigma * 0.9;
+    EXPECT_FALSE(CheckRegisteredViews(r, 18, refuse).has_value());
+
     // 20% of 40 alignments rejected is the limit; 9 of 40 is past it.
     EXPECT_FALSE(CheckRegisteredViews(Registered(32, 8, 0.001), 18, refuse).has_value());
     EXPECT_EQ(CheckRegisteredViews(Registered(31, 9, 0.001), 18, refuse)->code,

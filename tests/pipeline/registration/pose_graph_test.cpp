@@ -74,6 +74,33 @@ TEST(OptimizePoseGraph, PerturbedRingComesBackConsistent) {
     EXPECT_LT(report->max_model_yaw_deviation_rad, 1.5 * kDeg);
 }
 
+TEST(OptimizePoseGraph, TellsHowFarTheAlignmentsCentreLiesFromTheCalibrations) {
+    PoseGraphConfig config;
+    config.edge_displacement_sigma_m = 0.0002;
+    config.calibration_center_sigma_m = 0.001;
+    // The axis 5 mm from the calibrated one: the alignments know it to a fraction of a
+    // millimetre, so the two differ by about 5 of the calibration's sigmas.
+    Ring off = MakeRing(18, {0.003, -0.004}, 3);
+    auto report = OptimizePoseGraph(off.graph, config);
+    ASSERT_TRUE(report.ok()) << report.error().message;
+    ASSERT_FALSE(off.graph.centre_from_calibration);
+    EXPECT_NEAR(report->centre_offset_m, 0.005, 0.0005);
+    EXPECT_GT(report->centre_disagreement, 3.5);
+    EXPECT_LT(report->centre_disagreement, 5.0);
+    // A calibration said to be good to 1 cm: the same 5 mm is half a sigma.
+    Ring loose = MakeRing(18, {0.003, -0.004}, 3);
+    config.calibration_center_sigma_m = 0.01;
+    report = OptimizePoseGraph(loose.graph, config);
+    ASSERT_TRUE(report.ok());
+    EXPECT_LT(report->centre_disagreement, 0.6);
+    // Where the axis is the calibrated one, nothing disagrees.
+    Ring on = MakeRing(18, {0.0, 0.0}, 3);
+    config.calibration_center_sigma_m = 0.001;
+    report = OptimizePoseGraph(on.graph, config);
+    ASSERT_TRUE(report.ok());
+    EXPECT_LT(report->centre_disagreement, 1.0);
+}
+
 TEST(OptimizePoseGraph, WeighsEdgesAndPriorByTheirResiduals) {
     // Edges good to 0.02 mm on a table whose angles are 0.3 degrees off, solved with the
     // configured sigmas (edges to 1 mm, angles to 0.5 degrees): as configured, the prior's pull
