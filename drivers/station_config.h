@@ -55,7 +55,7 @@ Result<YAML::Node> LoadConfigSections(const std::filesystem::path& path);
 
 // Top-level sections that belong to other parts of boxd (the daemon's) and are skipped here.
 inline const std::vector<std::string> kOtherConfigSections = {"server", "storage", "mqtt",
-                                                              "measurement"};
+                                                              "measurement", "billing"};
 
 struct StationConfig {
     TurntableConfig turntable;

@@ -6,6 +6,7 @@
 
 #include "daemon/cli/cli.h"
 #include "daemon/cli/cli_progress.h"
+#include "daemon/service/billing.h"
 #include "daemon/service/daemon_config.h"
 #include "drivers/station_config.h"
 #include "pipeline/core/json_text.h"
@@ -46,13 +47,17 @@ int RunMeasure(const MeasureOptions& opt) {
         session->calibration = *calibration;
     }
     MeasureConfig config;
+    std::optional<BillingConfig> billing;
     if (!opt.config.empty()) {
-        // The station's `measurement:` settings, as its daemon measures with them.
+        // The station's `measurement:` and `billing:` settings, as its daemon uses them.
         auto loaded = LoadMeasurementConfig(opt.config);
         if (!loaded) {
             return Fail(Error{ErrorCode::kInvalidInput, "--config: " + loaded.error().message});
         }
         config = *loaded;
+        auto bills = LoadBillingConfig(opt.config);
+        if (!bills) return Fail(Error{ErrorCode::kInvalidInput, "--config: " + bills.error().message});
+        billing = *bills;
     }
     const BoxMethod method = opt.method == "pca" ? BoxMethod::kPca : BoxMethod::kFootprint;
     // The command line is an edge of the pipeline: it owns the id, the timestamps and the clock.
@@ -82,6 +87,7 @@ int RunMeasure(const MeasureOptions& opt) {
             return Fail(Error{ErrorCode::kInvalidInput, "--cloud: " + s.error().message});
         }
     }
+    AddBilling(result, billing, std::nullopt);
     const std::string text = JsonText(ToJson(out->result), 2);
     std::fprintf(stdout, "%s\n", text.c_str());
     std::fflush(stdout);
@@ -111,7 +117,8 @@ void AddMeasure(CLI::App& app, Runner& run) {
                     "session's calibration block");
     sub->add_option("--config", opt->config,
                     "a station config file: its `measurement:` section (max_uncertainty_m, "
-                    "calibration_center_sigma_m) replaces the defaults");
+                    "calibration_center_sigma_m) replaces the defaults, and its `billing:` "
+                    "section adds the result's billing block");
     sub->add_option("--parcel-id", opt->parcel_id,
                     "the parcel's id (e.g. its scanned barcode: 1 to 64 printable ASCII "
                     "characters), kept in the result as parcel_id");

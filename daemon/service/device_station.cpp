@@ -242,6 +242,7 @@ JobOutput DeviceStation::Measure(const JobContext& ctx) {
     out.result.quality.stop_reason = stopped_early ? "target_uncertainty" : "pose_budget";
     // From the last frame to the result: what the overlap shortens.
     out.result.timing_ms["processing"] = MsSince(last_frame_at_);
+    AddBilling(out.result, config_.billing, std::nullopt);
     if (!measured->cloud.empty()) {
         const auto ply = ctx.scratch_dir / "cloud.ply";
         if (Status s = WritePly(ply, measured->cloud); s) {

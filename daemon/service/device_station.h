@@ -13,6 +13,7 @@
 #include <mutex>
 #include <optional>
 
+#include "daemon/service/billing.h"
 #include "daemon/service/pose_preparer.h"
 #include "daemon/service/station.h"
 #include "drivers/driver_registry.h"
@@ -24,6 +25,7 @@ namespace boxd {
 struct DeviceStationConfig {
     StationConfig station;
     MeasureConfig measure;
+    std::optional<BillingConfig> billing;  // the `billing:` section, when the station bills
     BoxMethod method = BoxMethod::kFootprint;
     // The config file the calibration came from: its modification time dates the calibration.
     std::filesystem::path config_file;

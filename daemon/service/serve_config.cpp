@@ -31,6 +31,9 @@ Result<ServeConfig> LoadServeConfig(const std::filesystem::path& file,
         return fail(s.error().message);
     }
     if (Status s = config.station.measure.Validate(); !s) return fail(s.error().message);
+    auto billing = ParseBillingConfig(root["billing"]);
+    if (!billing) return fail(billing.error().message);
+    config.station.billing = *billing;
 
     // The command line wins over the file, and is validated the same way.
     if (overrides.listen) {

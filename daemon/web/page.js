@@ -87,6 +87,29 @@ async function refreshStatus() {
 }
 
 // Shows measurement `id` (null: the latest) in the result panel, with its 3-D view.
+// The station's billing block (its config's billing: section), or nothing without one.
+function showBilling(b) {
+  const table = $("billing");
+  table.replaceChildren();
+  table.hidden = !b;
+  if (!b) return;
+  const u = b.units;
+  row(table, [["Billing", "wide"], [b.billable ? "billable" : "not billable", "value"],
+              [b.billable ? `${b.rounding}, ${b.length.division} ${u.length} divisions` : b.reason]]);
+  for (const name of ["length", "width", "height"]) {
+    const d = b[name];
+    row(table, [[name], [d.divisions != null ? `${d.value} ${u.length}` : "—", "value"],
+                [d.divisions != null ? `${d.divisions} × ${d.division} ${u.length}` : d.why_not]]);
+  }
+  if (b.volume != null) row(table, [["volume"], [`${b.volume} ${u.volume}`, "value"], [""]]);
+  if (b.actual_weight != null) row(table, [["weighed"], [`${b.actual_weight} ${u.weight}`, "value"], [""]]);
+  for (const c of b.carriers) {
+    const billed = c.billable_weight != null ? `bills ${c.billable_weight} ${u.weight}` : "not weighed";
+    row(table, [[c.carrier], [`${c.dimensional_weight} ${u.weight}`, "value"],
+                [`dimensional at ${c.divisor} ${u.volume}/${u.weight}; ${billed}`]]);
+  }
+}
+
 async function openMeasurement(id) {
   let m;
   try {
@@ -112,8 +135,10 @@ async function openMeasurement(id) {
     row(dims, [["Volume"], [`${(d.volume_m3 * 1000).toFixed(2)} L`, "value"], [""]]);
     row(dims, [["Shape"], [m.shape || ""], [""]]);
     text($("last-note"), `${m.status}, ${m.quality.poses} poses, ${when}`);
+    showBilling(m.billing);
   } else {
     text($("last-note"), `${m.status}: ${m.reason.code}: ${m.reason.message} (${when})`);
+    showBilling(null);
   }
   for (const tr of $("history-table").rows) tr.classList.toggle("shown", tr.dataset.id === m.id);
   try {

@@ -72,6 +72,9 @@ Status CheckParcelId(const std::string& id) {
     return OkStatus();
 }
 
+double WrittenLength(double metres) { return Round(metres, 1e-5); }
+double WrittenBound(double metres) { return RoundBound(metres, 1e-5); }
+
 json ToJson(const MeasurementResult& m) {
     json j;
     j["id"] = m.id;
@@ -132,6 +135,7 @@ json ToJson(const MeasurementResult& m) {
     json timing = json::object();
     for (const auto& [stage, ms] : m.timing_ms) timing[stage] = Round(ms, 0.1);
     j["timing_ms"] = timing;
+    if (m.billing) j["billing"] = ToJson(*m.billing);
     return j;
 }
 

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "pipeline/core/result.h"
+#include "pipeline/io/billing_block.h"
 
 namespace boxd {
 
@@ -81,6 +82,9 @@ struct MeasurementResult {
     std::optional<DimensionUncertainty> uncertainty_m;  // with dimensions
     MeasurementQuality quality;
     std::map<std::string, double> timing_ms;  // stage name -> milliseconds
+    // The station's billing of the dimensions (a station with a `billing:` section, a measured
+    // object); an addition to SPEC section 5.
+    std::optional<Billing> billing;
 };
 
 const char* StatusName(MeasurementStatus s);
@@ -89,6 +93,12 @@ const char* StatusName(MeasurementStatus s);
 // text); otherwise an INVALID_INPUT error saying what is wrong, for the caller to prefix with
 // the field's name.
 Status CheckParcelId(const std::string& id);
+
+// A dimension (metres) and its 95% bound as ToJson writes them (to 0.01 mm; the bound with the
+// writing's own rounding, rounded up): the billing works from these, so that what a reader
+// recomputes from the JSON is what was billed.
+double WrittenLength(double metres);
+double WrittenBound(double metres);
 
 // Returns the SPEC section 5 JSON object of `m`.
 nlohmann::json ToJson(const MeasurementResult& m);

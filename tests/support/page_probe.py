@@ -42,6 +42,7 @@ PROBE = r"""JSON.stringify((() => {
     live: $('live').hidden ? null : {id: $('live-id').textContent, text: $('live-text').textContent, bar: $('live-bar').style.width},
     back_shown: !$('back-to-latest').hidden, clock_note: $('clock-note').textContent,
     calibration: $('calibration-facts').textContent, history_text: $('history-table').textContent,
+    billing: $('billing').hidden ? null : $('billing').textContent,
   };
 })())"""
 

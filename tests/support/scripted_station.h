@@ -8,6 +8,7 @@
 #include <fstream>
 #include <thread>
 
+#include "daemon/service/billing.h"
 #include "daemon/service/station.h"
 
 namespace boxd {
@@ -53,6 +54,8 @@ public:
         out.result.status = MeasurementStatus::kOk;
         out.result.dimensions = MeasuredDimensions{0.4, 0.3, 0.2, 0.024, "footprint"};
         out.result.quality.poses = 4;
+        // A station that bills, weighed at 2.5 kg (the block's schema is checked on it).
+        out.result.billing = Bill({0.4, 0.3, 0.2}, {0.001, 0.001, 0.001}, 2.5, BillingConfig{});
         const auto ply = ctx.scratch_dir / "cloud.ply";
         std::ofstream(ply) << "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n";
         out.files.cloud_ply = ply;

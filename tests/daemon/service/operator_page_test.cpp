@@ -100,6 +100,15 @@ TEST(OperatorPage, FitsPhoneTabletAndDesktopAndShowsWhatIsMeasuredNow) {
     // The calibration card: what a technician needs, not a path.
     EXPECT_NE(desktop["calibration"].get<std::string>().find("Made"), std::string::npos);
     EXPECT_EQ(desktop["calibration"].get<std::string>().find(".yaml"), std::string::npos);
+    // config/sim.yaml bills: the result's block is on the page, each carrier by name.
+    ASSERT_TRUE(second.contains("billing")) << second.dump();
+    ASSERT_TRUE(desktop["billing"].is_string()) << "no billing table";
+    const std::string billing = desktop["billing"].get<std::string>();
+    EXPECT_NE(billing.find(second["billing"]["billable"].get<bool>() ? "billable" : "not billable"),
+              std::string::npos)
+        << billing;
+    EXPECT_NE(billing.find("express"), std::string::npos) << billing;
+    EXPECT_NE(billing.find("air"), std::string::npos) << billing;
 
     // While the next parcel is measured: the live panel, the previous result dimmed and named.
     const json& measuring = steps[6];
