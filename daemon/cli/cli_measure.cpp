@@ -56,7 +56,8 @@ int RunMeasure(const MeasureOptions& opt) {
         }
         config = *loaded;
         auto bills = LoadBillingConfig(opt.config);
-        if (!bills) return Fail(Error{ErrorCode::kInvalidInput, "--config: " + bills.error().message});
+        if (!bills)
+            return Fail(Error{ErrorCode::kInvalidInput, "--config: " + bills.error().message});
         billing = *bills;
     }
     const BoxMethod method = opt.method == "pca" ? BoxMethod::kPca : BoxMethod::kFootprint;

@@ -35,10 +35,10 @@ BilledDimension BillDimension(int k, double value_m, double bound_m, const Billi
     d.division = Display(division, c.units);
     const char* unit = LengthUnit(c.units);
     if (value_m < c.min_dimension_m || value_m > c.max_dimension_m) {
-        d.why_not = fmt::format("{} {:.1f} {} is outside the measuring range {:.1f}-{:.1f} {}",
-                                kNames[k], Display(value_m, c.units), unit,
-                                Display(c.min_dimension_m, c.units),
-                                Display(c.max_dimension_m, c.units), unit);
+        d.why_not =
+            fmt::format("{} {:.1f} {} is outside the measuring range {:.1f}-{:.1f} {}", kNames[k],
+                        Display(value_m, c.units), unit, Display(c.min_dimension_m, c.units),
+                        Display(c.max_dimension_m, c.units), unit);
         return d;
     }
     const long n = RoundDivisions(value_m / division, c.rounding);
@@ -121,11 +121,10 @@ void AddBilling(MeasurementResult& result, const std::optional<BillingConfig>& c
     if (!config || !result.dimensions || !result.uncertainty_m) return;
     const MeasuredDimensions& d = *result.dimensions;
     const DimensionUncertainty& u = *result.uncertainty_m;
-    result.billing = Bill({WrittenLength(d.length_m), WrittenLength(d.width_m),
-                           WrittenLength(d.height_m)},
-                          {WrittenBound(u.length_m), WrittenBound(u.width_m),
-                           WrittenBound(u.height_m)},
-                          actual_weight, *config);
+    result.billing =
+        Bill({WrittenLength(d.length_m), WrittenLength(d.width_m), WrittenLength(d.height_m)},
+             {WrittenBound(u.length_m), WrittenBound(u.width_m), WrittenBound(u.height_m)},
+             actual_weight, *config);
 }
 
 }  // namespace boxd

@@ -101,7 +101,8 @@ Result<std::optional<BillingConfig>> LoadBillingConfig(const std::filesystem::pa
     auto root = LoadConfigSections(file);
     if (!root) return root.error();
     auto billing = ParseBillingConfig((*root)["billing"]);
-    if (!billing) return Error{ErrorCode::kInvalidInput, file.string() + ": " + billing.error().message};
+    if (!billing)
+        return Error{ErrorCode::kInvalidInput, file.string() + ": " + billing.error().message};
     return billing;
 }
 

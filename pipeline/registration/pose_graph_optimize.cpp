@@ -76,10 +76,11 @@ Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfi
     }
     report.centre_disagreement = CentreDisagreement(graph, weighed);
     report.centre_offset_m = graph.centre_from_calibration ? 0.0 : graph.center_offset.norm();
-    spdlog::debug("pose graph: the table's centre from the {}, {:.2f} mm from the calibration's "
-                  "({:.1f} sigma)",
-                  graph.centre_from_calibration ? "calibration" : "alignments",
-                  report.centre_offset_m * 1e3, report.centre_disagreement);
+    spdlog::debug(
+        "pose graph: the table's centre from the {}, {:.2f} mm from the calibration's "
+        "({:.1f} sigma)",
+        graph.centre_from_calibration ? "calibration" : "alignments", report.centre_offset_m * 1e3,
+        report.centre_disagreement);
     std::vector<int> degree(graph.poses.size(), 0);
     for (const PoseEdge& e : graph.edges) {
         if (e.rejected) continue;

@@ -41,8 +41,9 @@ TEST(CliBilling, AKnownBoxIsBilledAsTheTableSays) {
     // A noise-free 400 x 300 x 200 mm box: in 5 mm divisions 80 x 60 x 40, 24,000 cm³, 4.8 kg
     // at 5000 cm³/kg and 4.0 kg at 6000.
     TempDir dir;
-    const auto session = Synth(dir, "box", {"--dims", "0.4", "0.3", "0.2", "--noise", "none",
-                                            "--poses", "12", "--seed", "3"});
+    const auto session =
+        Synth(dir, "box",
+              {"--dims", "0.4", "0.3", "0.2", "--noise", "none", "--poses", "12", "--seed", "3"});
     auto r = MeasureWith(dir, session,
                          "billing:\n  division_m: 0.005\n  divisors:\n    express: 5000\n"
                          "    air: 6000\n");
@@ -86,8 +87,9 @@ TEST(CliBilling, ADimensionIsStatedOnlyWhereItsBoundKeepsItWithinTheTolerance) {
     // dimension is stated exactly when its bound plus the rounding's move is within one
     // division, as read back from the result itself; the measurement stays ok.
     TempDir dir;
-    const auto session = Synth(dir, "noisy", {"--dims", "0.35", "0.25", "0.2", "--noise",
-                                              "kinect", "--poses", "4", "--seed", "11"});
+    const auto session = Synth(
+        dir, "noisy",
+        {"--dims", "0.35", "0.25", "0.2", "--noise", "kinect", "--poses", "4", "--seed", "11"});
     const auto r = MeasureWith(dir, session, "billing:\n  division_m: 0.001\n");
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const json j = json::parse(r.out);
@@ -104,8 +106,7 @@ TEST(CliBilling, ADimensionIsStatedOnlyWhereItsBoundKeepsItWithinTheTolerance) {
         EXPECT_EQ(b[name]["divisions"].is_null(), !within) << name << " " << b.dump(2);
         if (!within) {
             ++unstated;
-            EXPECT_NE(b[name]["why_not"].get<std::string>().find("its bound"),
-                      std::string::npos);
+            EXPECT_NE(b[name]["why_not"].get<std::string>().find("its bound"), std::string::npos);
         }
     }
     EXPECT_GT(unstated, 0) << "four poses of a Kinect box leave a bound over a millimetre";
@@ -115,8 +116,9 @@ TEST(CliBilling, ADimensionIsStatedOnlyWhereItsBoundKeepsItWithinTheTolerance) {
 
 TEST(CliBilling, ABadSectionIsBadInputNamingTheKey) {
     TempDir dir;
-    const auto session = Synth(dir, "box", {"--dims", "0.3", "0.2", "0.2", "--noise", "none",
-                                            "--poses", "4", "--seed", "5"});
+    const auto session =
+        Synth(dir, "box",
+              {"--dims", "0.3", "0.2", "0.2", "--noise", "none", "--poses", "4", "--seed", "5"});
     const std::pair<std::string, std::string> cases[] = {
         {"billing:\n  division: 0.005\n", "billing.division: unknown key"},
         {"billing:\n  units: imperial\n  division_m: 0.005\n", "billing.division_m: unknown key"},

@@ -102,8 +102,8 @@ TEST(Bill, ImperialInFifthsOfAnInchAndPoundsPerCubicInch) {
     c.weight_division = 1.0;  // whole pounds
     c.divisors = {{"domestic", 139.0}};
     // 12.0 x 10.1 x 7.95 in: 60, 50.5 -> 51 (10.2 in), 39.75 -> 40 (8.0 in).
-    const Billing b = Bill({12.0 * kInch, 10.1 * kInch, 7.95 * kInch},
-                           {0.002, 0.002, 0.002}, std::nullopt, c);
+    const Billing b =
+        Bill({12.0 * kInch, 10.1 * kInch, 7.95 * kInch}, {0.002, 0.002, 0.002}, std::nullopt, c);
     ASSERT_TRUE(b.billable) << b.reason;
     EXPECT_EQ(b.dimensions[0].divisions, 60);
     EXPECT_EQ(b.dimensions[1].divisions, 51);
@@ -121,8 +121,8 @@ TEST(Bill, TheResultCarriesTheBlock) {
     MeasurementResult r;
     r.status = MeasurementStatus::kOk;
     EXPECT_FALSE(ToJson(r).contains("billing"));
-    r.billing = Bill({0.4, 0.3, 0.2024}, {0.001, 0.009, 0.001}, 3.2,
-                     Metric(BillingRounding::kNearest));
+    r.billing =
+        Bill({0.4, 0.3, 0.2024}, {0.001, 0.009, 0.001}, 3.2, Metric(BillingRounding::kNearest));
     const nlohmann::json j = ToJson(r)["billing"];
     EXPECT_EQ(j["billable"], false);
     EXPECT_EQ(j["units"]["length"], "mm");
@@ -136,8 +136,7 @@ TEST(Bill, TheResultCarriesTheBlock) {
     EXPECT_TRUE(j["volume"].is_null());
     EXPECT_EQ(j["actual_weight"], 3.2);
     EXPECT_TRUE(j["carriers"].empty());
-    r.billing = Bill({0.4, 0.3, 0.2}, {0.001, 0.001, 0.001}, 3.2,
-                     Metric(BillingRounding::kUp));
+    r.billing = Bill({0.4, 0.3, 0.2}, {0.001, 0.001, 0.001}, 3.2, Metric(BillingRounding::kUp));
     const nlohmann::json k = ToJson(r)["billing"];
     EXPECT_EQ(k["billable"], true);
     EXPECT_TRUE(k["reason"].is_null());
