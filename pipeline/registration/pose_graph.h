@@ -111,24 +111,26 @@ struct PoseGraphReport {
     double centre_disagreement = 0.0;
 };
 
-// Whether the alignments and the turntable prior of `graph`, without the edges' slides, at its
-// poses and the sigmas of `config`, leave the table's centre less well known than the
-// calibration says it is (calibration_center_sigma_m) along some direction: the Schur
-// complement of their information on the centre, against the calibration's. Where they know it
-// better, the centre comes from them (PoseGraph::centre_from_calibration); where they do not
-// (four views a quarter turn apart leave a direction free), the calibration is all there is.
-bool CalibrationCounts(const PoseGraph& graph, const PoseGraphConfig& config);
-
 // The information (inverse covariance, 2 x 2) the alignments and the turntable prior of `graph`,
-// without the edges' slides, give the table's centre at its poses (CalibrationCounts' Schur
-// complement); none where the graph cannot be linearised.
+// without the edges' slides, give the table's centre at its poses and the sigmas of `config`: the
+// Schur complement of their information on the centre. None where the graph cannot be
+// linearised.
 std::optional<Eigen::Matrix2d> CentreInformation(const PoseGraph& graph,
                                                  const PoseGraphConfig& config);
 
-// How far the alignments' centre of `graph` (its centre_offset, from the calibration's) lies
-// from the calibration's, in the standard deviations of their difference (the alignments' and
-// calibration_center_sigma_m together): sqrt(dᵀ Σ⁻¹ d). 0 where the centre is the calibration's.
-double CentreDisagreement(const PoseGraph& graph, const PoseGraphConfig& config);
+// Whether the alignments, with the information `centre` (CentreInformation) on the table's
+// centre, know it less well than the calibration says it is (calibration_center_sigma_m of
+// `config`) along some direction. Where they know it better, the centre comes from them
+// (PoseGraph::centre_from_calibration); where they do not (four views a quarter turn apart leave
+// a direction free), or nothing could be computed, the calibration is all there is.
+bool CalibrationCounts(const std::optional<Eigen::Matrix2d>& centre, const PoseGraphConfig& config);
+
+// How far the alignments' centre `offset` (from the calibration's), known with the information
+// `centre`, lies from the calibration's, in the standard deviations of their difference (the
+// alignments' and calibration_center_sigma_m together): sqrt(dᵀ Σ⁻¹ d); 0 when it cannot be told.
+double CentreDisagreement(const Eigen::Vector2d& offset,
+                          const std::optional<Eigen::Matrix2d>& centre,
+                          const PoseGraphConfig& config);
 
 // Solves `graph` once with the edges not marked rejected; updates poses and centre offset.
 Status SolvePoseGraph(PoseGraph& graph, const PoseGraphConfig& config);

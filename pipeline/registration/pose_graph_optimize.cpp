@@ -69,12 +69,16 @@ Result<PoseGraphReport> OptimizePoseGraph(PoseGraph& graph, const PoseGraphConfi
     graph.centre_from_calibration = false;
     PoseGraphConfig weighed = config;
     if (Status s = RejectAndWeigh(graph, config, report, weighed); !s) return s.error();
-    if (CalibrationCounts(graph, weighed)) {
+    // What the alignments know of the centre decides where it comes from and, when from them,
+    // how far it lies from the calibration's.
+    const std::optional<Eigen::Matrix2d> centre = CentreInformation(graph, weighed);
+    if (CalibrationCounts(centre, weighed)) {
         graph = start;
         graph.centre_from_calibration = true;
         if (Status s = RejectAndWeigh(graph, config, report, weighed); !s) return s.error();
+    } else {
+        report.centre_disagreement = CentreDisagreement(graph.center_offset, centre, weighed);
     }
-    report.centre_disagreement = CentreDisagreement(graph, weighed);
     report.centre_offset_m = graph.centre_from_calibration ? 0.0 : graph.center_offset.norm();
     spdlog::debug(
         "pose graph: the table's centre from the {}, {:.2f} mm from the calibration's "

@@ -263,8 +263,8 @@ std::optional<Eigen::Matrix2d> CentreInformation(const PoseGraph& graph,
                            cross.transpose() * solved);
 }
 
-bool CalibrationCounts(const PoseGraph& graph, const PoseGraphConfig& config) {
-    const auto centre = CentreInformation(graph, config);
+bool CalibrationCounts(const std::optional<Eigen::Matrix2d>& centre,
+                       const PoseGraphConfig& config) {
     if (!centre) return true;
     const double weakest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(*centre).eigenvalues()(0);
     const double s = config.calibration_center_sigma_m;
@@ -273,13 +273,13 @@ bool CalibrationCounts(const PoseGraph& graph, const PoseGraphConfig& config) {
     return !(weakest > 1.0 / (s * s));
 }
 
-double CentreDisagreement(const PoseGraph& graph, const PoseGraphConfig& config) {
-    if (graph.centre_from_calibration) return 0.0;
-    const auto centre = CentreInformation(graph, config);
+double CentreDisagreement(const Eigen::Vector2d& offset,
+                          const std::optional<Eigen::Matrix2d>& centre,
+                          const PoseGraphConfig& config) {
     if (!centre) return 0.0;
     const double s = config.calibration_center_sigma_m;
     const Eigen::Matrix2d both = centre->inverse() + s * s * Eigen::Matrix2d::Identity();
-    const double d2 = graph.center_offset.dot(both.ldlt().solve(graph.center_offset));
+    const double d2 = offset.dot(both.ldlt().solve(offset));
     return std::isfinite(d2) && d2 > 0.0 ? std::sqrt(d2) : 0.0;
 }
 
