@@ -9,8 +9,6 @@ namespace boxd {
 
 namespace {
 
-constexpr double kInch = 0.0254;
-constexpr const char* kNames[3] = {"length", "width", "height"};
 // Quotients within this of a whole number are that number: 0.2 m in 5 mm divisions is 40, not
 // 40.000000000000007 rounded up to 41.
 constexpr double kWhole = 1e-9;
@@ -21,7 +19,7 @@ Status Bad(const std::string& key, const std::string& why) {
 
 // Metres in the display unit (mm or in).
 double Display(double metres, BillingUnits units) {
-    return units == BillingUnits::kMetric ? metres * 1000.0 : metres / kInch;
+    return units == BillingUnits::kMetric ? metres * 1000.0 : metres / kMetresPerInch;
 }
 
 long RoundDivisions(double quotient, BillingRounding rounding) {
@@ -35,10 +33,10 @@ BilledDimension BillDimension(int k, double value_m, double bound_m, const Billi
     d.division = Display(division, c.units);
     const char* unit = LengthUnit(c.units);
     if (value_m < c.min_dimension_m || value_m > c.max_dimension_m) {
-        d.why_not =
-            fmt::format("{} {:.1f} {} is outside the measuring range {:.1f}-{:.1f} {}", kNames[k],
-                        Display(value_m, c.units), unit, Display(c.min_dimension_m, c.units),
-                        Display(c.max_dimension_m, c.units), unit);
+        d.why_not = fmt::format(
+            "{} {:.1f} {} is outside the measuring range {:.1f}-{:.1f} {}",
+            kBilledDimensions[static_cast<std::size_t>(k)], Display(value_m, c.units), unit,
+            Display(c.min_dimension_m, c.units), Display(c.max_dimension_m, c.units), unit);
         return d;
     }
     const long n = RoundDivisions(value_m / division, c.rounding);
@@ -46,8 +44,9 @@ BilledDimension BillDimension(int k, double value_m, double bound_m, const Billi
     if (bound_m + moved_m > c.max_error_divisions * division * (1.0 + kWhole)) {
         d.why_not = fmt::format(
             "{}: its bound {:.2f} {} and the rounding's {:.2f} {} exceed {:g} division of {:g} {}",
-            kNames[k], Display(bound_m, c.units), unit, Display(moved_m, c.units), unit,
-            c.max_error_divisions, Display(division, c.units), unit);
+            kBilledDimensions[static_cast<std::size_t>(k)], Display(bound_m, c.units), unit,
+            Display(moved_m, c.units), unit, c.max_error_divisions, Display(division, c.units),
+            unit);
         return d;
     }
     d.stated = true;

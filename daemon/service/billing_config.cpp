@@ -13,8 +13,6 @@ using config_keys::CheckKeys;
 using config_keys::ConfigError;
 using config_keys::ReadKey;
 
-constexpr double kInch = 0.0254;
-
 // The division: one value for every dimension, or [length, width, height]; `scale` to metres.
 Status ReadDivision(const YAML::Node& node, const std::string& key, double scale,
                     std::array<double, 3>& out) {
@@ -77,7 +75,7 @@ Result<std::optional<BillingConfig>> ParseBillingConfig(const YAML::Node& node) 
         return s.error();
     }
     c.units = metric ? BillingUnits::kMetric : BillingUnits::kImperial;
-    const double scale = metric ? 1.0 : kInch;
+    const double scale = metric ? 1.0 : kMetresPerInch;
     double lo = c.min_dimension_m / scale, hi = c.max_dimension_m / scale;
     for (Status s : {ReadKey(node, "billing", "rounding", rounding),
                      ReadKey(node, "billing", min_key.c_str(), lo),

@@ -30,15 +30,14 @@ json ToJson(const Billing& b) {
                   {"volume", VolumeUnit(b.units)},
                   {"weight", WeightUnit(b.units)}};
     j["rounding"] = b.rounding;
-    const char* names[3] = {"length", "width", "height"};
     for (std::size_t k = 0; k < 3; ++k) {
         const BilledDimension& d = b.dimensions[k];
-        j[names[k]] = d.stated ? json{{"divisions", d.divisions},
-                                      {"division", Tidy(d.division)},
-                                      {"value", Tidy(d.value)}}
-                               : json{{"divisions", nullptr},
-                                      {"division", Tidy(d.division)},
-                                      {"why_not", d.why_not}};
+        j[kBilledDimensions[k]] = d.stated ? json{{"divisions", d.divisions},
+                                                  {"division", Tidy(d.division)},
+                                                  {"value", Tidy(d.value)}}
+                                           : json{{"divisions", nullptr},
+                                                  {"division", Tidy(d.division)},
+                                                  {"why_not", d.why_not}};
     }
     j["volume"] = b.billable ? json(Tidy(b.volume)) : json(nullptr);
     j["actual_weight"] = Optional(b.actual_weight);

@@ -14,6 +14,10 @@ namespace boxd {
 
 enum class BillingUnits { kMetric, kImperial };  // mm, cm³, kg | in, in³, lb
 
+inline constexpr double kMetresPerInch = 0.0254;
+// The billed dimensions in their order, as the block names them.
+inline constexpr std::array<const char*, 3> kBilledDimensions{"length", "width", "height"};
+
 // "mm" or "in"; "cm3" or "in3"; "kg" or "lb".
 const char* LengthUnit(BillingUnits units);
 const char* VolumeUnit(BillingUnits units);
