@@ -40,8 +40,7 @@ Result<std::unique_ptr<DepthCamera>> MakeDepthCamera(const CameraConfig& config,
     return std::unique_ptr<DepthCamera>(std::make_unique<ReplayCamera>(*source));
 }
 
-Result<StationDevices> OpenStation(const StationConfig& config,
-                                   const std::atomic<bool>* cancel) {
+Result<StationDevices> OpenStation(const StationConfig& config, const std::atomic<bool>* cancel) {
     StationDevices devices;
     devices.capture = config.capture;
     devices.calibrated = config.calibration.has_value();
@@ -78,6 +77,12 @@ Result<StationDevices> OpenStation(const StationConfig& config,
         devices.camera = std::move(camera).value();
     }
     if (auto st = devices.camera->Open(); !st) return st.error();
+    if (config.scale.enabled()) {
+        auto scale = MakeScale(config.scale);
+        if (!scale) return scale.error();
+        devices.scale = std::move(scale).value();
+        spdlog::info("scale: {}", devices.scale->Describe());
+    }
     spdlog::info("turntable: {}", devices.turntable->Describe());
     spdlog::info("camera: {}", devices.camera->Describe());
     return devices;

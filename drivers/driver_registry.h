@@ -4,11 +4,13 @@
 //   camera.driver: openni2 | simulated | replay
 //   turntable.driver: modbus-tcp | modbus-rtu | simulated (MakeTurntable); a replay camera
 //   brings its own replay turntable and the turntable section is not used.
+//   scale.driver: none | modbus-tcp | modbus-rtu | simulated (MakeScale).
 
 #include <atomic>
 #include <memory>
 
 #include "drivers/depth_camera.h"
+#include "drivers/scale.h"
 #include "drivers/station_config.h"
 #include "drivers/turntable.h"
 
@@ -20,6 +22,7 @@ struct StationDevices {
     // camera is destroyed first.
     std::unique_ptr<Turntable> turntable;
     std::unique_ptr<DepthCamera> camera;
+    std::unique_ptr<Scale> scale;  // null when the station has none
     // The config's capture settings; for a replay station the session's angles and frame count.
     CaptureConfig capture;
     // What goes into captured sessions (config calibration; for replay without one, the
@@ -35,9 +38,10 @@ Result<std::unique_ptr<DepthCamera>> MakeDepthCamera(const CameraConfig& config,
                                                      Turntable* turntable,
                                                      TurntableDirection direction);
 
-// Returns the turntable (connected) and the camera (opened) of `config`, or the first
-// TURNTABLE_ERROR / CAMERA_ERROR / INVALID_SESSION error. Setting `*cancel` abandons a wait for
-// a device to come up (the simulated drive's launch) with an ABORTED error.
+// Returns the turntable (connected), the camera (opened) and the scale (connected, if any) of
+// `config`, or the first TURNTABLE_ERROR / CAMERA_ERROR / SCALE_ERROR / INVALID_SESSION error.
+// Setting `*cancel` abandons a wait for a device to come up (the simulated drive's launch) with an
+// ABORTED error.
 Result<StationDevices> OpenStation(const StationConfig& config,
                                    const std::atomic<bool>* cancel = nullptr);
 

@@ -65,7 +65,7 @@ std::string ModbusClient::Describe() const {
 Status ModbusClient::Connect() {
     std::string why;
     if (OpenLink(why)) return OkStatus();
-    return Error{ErrorCode::kTurntableError, Describe() + ": " + why};
+    return Error{config_.error_code, Describe() + ": " + why};
 }
 
 bool ModbusClient::OpenLink(std::string& why) {
@@ -123,16 +123,15 @@ Status ModbusClient::Transact(const std::string& what, Fn&& fn) {
                 last_error = std::string("Modbus exception: ") + modbus_strerror(err);
                 continue;
             }
-            return Error{
-                ErrorCode::kTurntableError,
-                Describe() + ": " + what +
-                    ": the drive answered with a Modbus exception: " + modbus_strerror(err)};
+            return Error{config_.error_code, Describe() + ": " + what +
+                                                 ": the device answered with a Modbus exception: " +
+                                                 modbus_strerror(err)};
         }
         // Transport failure: the connection may be dead or hold a late reply; start afresh.
         last_error = ErrnoText(err, config_.response_timeout_ms);
         Close();
     }
-    return Error{ErrorCode::kTurntableError,
+    return Error{config_.error_code,
                  Describe() + ": " + what + " failed after " + std::to_string(attempts) +
                      (attempts == 1 ? " attempt: " : " attempts: ") + last_error};
 }

@@ -2,8 +2,9 @@
 // ModbusClient: one Modbus TCP or RTU connection (libmodbus) with bounded retries. A transport
 // failure (timeout, dropped connection, garbled reply) closes the connection and the next
 // attempt reconnects; a Modbus exception reply is the device's answer and is not retried
-// (except "busy" and "acknowledge", which mean "ask again"). Errors are TURNTABLE_ERROR with a
-// message that names the device and the transaction.
+// (except "busy" and "acknowledge", which mean "ask again"). Errors carry the link's device
+// error code (TURNTABLE_ERROR for a drive, SCALE_ERROR for a weighing indicator) and a message
+// that names the device and the transaction.
 
 #include <cstdint>
 #include <memory>
@@ -27,7 +28,29 @@ struct ModbusLinkConfig {
     int response_timeout_ms = 300;
     int retries = 2;
     int retry_delay_ms = 50;
+    ErrorCode error_code = ErrorCode::kTurntableError;  // the code of the link's errors
 };
+
+// Returns the link settings of a device's config section (a turntable's or a scale's: the same
+// key names), as RTU when `rtu`, its errors carrying `code`.
+template <typename DeviceConfig>
+ModbusLinkConfig LinkConfigOf(const DeviceConfig& c, bool rtu, ErrorCode code) {
+    ModbusLinkConfig link;
+    link.rtu = rtu;
+    link.host = c.host;
+    link.port = c.port;
+    link.device = c.device;
+    link.baud = c.baud;
+    link.parity = c.parity.empty() ? 'N' : c.parity[0];
+    link.data_bits = c.data_bits;
+    link.stop_bits = c.stop_bits;
+    link.slave_id = c.slave_id;
+    link.response_timeout_ms = c.response_timeout_ms;
+    link.retries = c.retries;
+    link.retry_delay_ms = c.retry_delay_ms;
+    link.error_code = code;
+    return link;
+}
 
 class ModbusClient {
 public:

@@ -14,23 +14,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-ModbusLinkConfig LinkConfig(const TurntableConfig& c) {
-    ModbusLinkConfig link;
-    link.rtu = c.driver == "modbus-rtu";
-    link.host = c.host;
-    link.port = c.port;
-    link.device = c.device;
-    link.baud = c.baud;
-    link.parity = c.parity.empty() ? 'N' : c.parity[0];
-    link.data_bits = c.data_bits;
-    link.stop_bits = c.stop_bits;
-    link.slave_id = c.slave_id;
-    link.response_timeout_ms = c.response_timeout_ms;
-    link.retries = c.retries;
-    link.retry_delay_ms = c.retry_delay_ms;
-    return link;
-}
-
 bool Bit(uint16_t word, int bit) { return ((word >> bit) & 1u) != 0; }
 
 long ElapsedMs(Clock::time_point since) {
@@ -43,7 +26,8 @@ std::string Deg(double deg) { return fmt::format("{:.2f}°", deg); }
 }  // namespace
 
 ModbusTurntable::ModbusTurntable(const TurntableConfig& config)
-    : config_(config), client_(LinkConfig(config)) {}
+    : config_(config),
+      client_(LinkConfigOf(config, config.driver == "modbus-rtu", ErrorCode::kTurntableError)) {}
 
 Result<std::unique_ptr<ModbusTurntable>> ModbusTurntable::Open(const TurntableConfig& config) {
     if (auto st = config.Validate(); !st) return st.error();

@@ -69,7 +69,8 @@ Reader Noise(NoiseModel& target) {
         std::string name;
         if (auto st = Value(name)(node, key); !st) return st;
         auto model = ParseNoiseModel(name);
-        if (!model) return KeyError(key, "must be none, kinect, realsense or tof, got '" + name + "'");
+        if (!model)
+            return KeyError(key, "must be none, kinect, realsense or tof, got '" + name + "'");
         target = *model;
         return OkStatus();
     };
@@ -251,7 +252,7 @@ Result<StationConfig> ParseStationConfig(const YAML::Node& document) {
             return KeyError(name, "section given twice");
         }
         const bool known = name == "turntable" || name == "camera" || name == "capture" ||
-                           name == "calibration" ||
+                           name == "calibration" || name == "scale" ||
                            std::find(kOtherConfigSections.begin(), kOtherConfigSections.end(),
                                      name) != kOtherConfigSections.end();
         if (!known) return KeyError(name, "unknown section");
@@ -265,6 +266,9 @@ Result<StationConfig> ParseStationConfig(const YAML::Node& document) {
     auto capture = ParseCaptureConfig(root["capture"]);
     if (!capture) return capture.error();
     config.capture = *capture;
+    auto scale = ParseScaleConfig(root["scale"]);
+    if (!scale) return scale.error();
+    config.scale = *scale;
     if (root["calibration"] && !root["calibration"].IsNull()) {
         auto calibration = ParseCalibration(root["calibration"]);
         if (!calibration) return calibration.error();

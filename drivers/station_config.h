@@ -1,7 +1,8 @@
 #pragma once
-// The station config file: the `turntable:`, `camera:`, `capture:` and `calibration:` sections
-// of the YAML file `boxd record` and `boxd serve` read. Every key is checked: an unknown key, a
-// wrong type or an invalid value is an INVALID_INPUT error naming the key ("camera.driver: ...").
+// The station config file: the `turntable:`, `camera:`, `capture:`, `scale:` and `calibration:`
+// sections of the YAML file `boxd record` and `boxd serve` read. Every key is checked: an unknown
+// key, a wrong type or an invalid value is an INVALID_INPUT error naming the key ("camera.driver:
+// ...").
 
 #include <filesystem>
 #include <optional>
@@ -11,6 +12,7 @@
 #include "drivers/capture_loop.h"
 #include "drivers/openni2_camera.h"
 #include "drivers/replay_source.h"
+#include "drivers/scale.h"
 #include "drivers/sim/simulated_camera.h"
 #include "drivers/turntable.h"
 #include "pipeline/core/station_calibration.h"
@@ -61,6 +63,7 @@ struct StationConfig {
     TurntableConfig turntable;
     CameraConfig camera;
     CaptureConfig capture;
+    ScaleConfig scale;  // driver none: the station has no scale
     // The calibration in force; absent in an uncalibrated station's config (a replay station
     // then uses the session's own calibration).
     std::optional<StationCalibration> calibration;

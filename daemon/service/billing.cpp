@@ -109,15 +109,27 @@ Billing Bill(const std::array<double, 3>& dimensions_m, const std::array<double,
         w.divisor = divisor;
         const double steps = std::ceil(b.volume / divisor / config.weight_division - kWhole);
         w.dimensional_weight = steps * config.weight_division;
-        if (actual_weight) w.billable_weight = std::max(*actual_weight, w.dimensional_weight);
+        if (actual_weight) {
+            const double actual = std::ceil(*actual_weight / config.weight_division - kWhole) *
+                                  config.weight_division;
+            w.billable_weight = std::max(actual, w.dimensional_weight);
+        }
         b.carriers.push_back(w);
     }
     return b;
 }
 
+std::optional<double> ActualWeight(const std::optional<Weighing>& weighing, BillingUnits units) {
+    if (!weighing || !weighing->value) return std::nullopt;
+    const bool in_kg = weighing->unit == "kg";
+    if (in_kg == (units == BillingUnits::kMetric)) return *weighing->value;
+    return in_kg ? *weighing->value / kKgPerLb : *weighing->value * kKgPerLb;
+}
+
 void AddBilling(MeasurementResult& result, const std::optional<BillingConfig>& config,
-                std::optional<double> actual_weight) {
+                const std::optional<Weighing>& weighing) {
     if (!config || !result.dimensions || !result.uncertainty_m) return;
+    const std::optional<double> actual_weight = ActualWeight(weighing, config->units);
     const MeasuredDimensions& d = *result.dimensions;
     const DimensionUncertainty& u = *result.uncertainty_m;
     result.billing =

@@ -58,13 +58,18 @@ Result<std::optional<BillingConfig>> ParseBillingConfig(const YAML::Node& node);
 Result<std::optional<BillingConfig>> LoadBillingConfig(const std::filesystem::path& file);
 
 // The billing of dimensions `dimensions_m` (length, width, height) with 95% bounds `bounds_m`, and
-// the scale's `actual_weight` (kg or lb in `config`'s units) when weighed. `config` is valid.
+// the scale's `actual_weight` (kg or lb in `config`'s units) when weighed. `config` is valid. The
+// billable weight is the larger of the dimensional and the actual weight, both rounded up to the
+// weight division.
 Billing Bill(const std::array<double, 3>& dimensions_m, const std::array<double, 3>& bounds_m,
              std::optional<double> actual_weight, const BillingConfig& config);
 
+// The scale's weight in the billing's units (kg or lb); none without a stated weight.
+std::optional<double> ActualWeight(const std::optional<Weighing>& weighing, BillingUnits units);
+
 // Sets `result.billing` from its dimensions and bounds as its JSON states them, when `config` is
-// given and the result has dimensions; `actual_weight` is the scale's (none without a scale).
+// given and the result has dimensions; `weighing` is the scale's (none without a scale).
 void AddBilling(MeasurementResult& result, const std::optional<BillingConfig>& config,
-                std::optional<double> actual_weight);
+                const std::optional<Weighing>& weighing);
 
 }  // namespace boxd

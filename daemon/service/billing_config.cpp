@@ -2,7 +2,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "daemon/service/billing.h"
-#include "daemon/service/config_keys.h"
+#include "drivers/config_keys.h"
 #include "drivers/station_config.h"
 
 namespace boxd {

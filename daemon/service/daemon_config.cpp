@@ -7,7 +7,7 @@
 #include <charconv>
 #include <set>
 
-#include "daemon/service/config_keys.h"
+#include "drivers/config_keys.h"
 #include "drivers/station_config.h"
 
 namespace boxd {

@@ -4,6 +4,7 @@
 
 #include <chrono>
 
+#include "drivers/weighing.h"
 #include "pipeline/io/ply_writer.h"
 #include "pipeline/io/session_io.h"
 #include "pipeline/measure_pipeline.h"
@@ -89,10 +90,12 @@ Status DeviceStation::OpenLocked() {
     }
     const std::string turntable = opened->turntable->Describe();
     const std::string camera = opened->camera->Describe();
+    const std::string scale = opened->scale ? opened->scale->Describe() : "";
     {
         std::lock_guard lock(devices_mutex_);
         turntable_description_ = turntable;
         camera_description_ = camera;
+        scale_description_ = scale;
         device_error_.reset();
         devices_ = std::move(opened);
         open_ = true;
@@ -185,7 +188,34 @@ Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms
     return session;
 }
 
+Result<std::optional<Weighing>> DeviceStation::Weigh(const JobContext& ctx) {
+    std::lock_guard life(lifecycle_mutex_);
+    std::shared_ptr<StationDevices> devices;
+    {
+        std::lock_guard lock(devices_mutex_);
+        devices = devices_;
+    }
+    if (!devices || !open_) return Error{ErrorCode::kCameraError, "the devices are not open"};
+    if (!devices->scale) return std::optional<Weighing>();
+    if (ctx.progress) ctx.progress(JobProgress{"weighing", 0, 0});
+    Result<Weighing> weighed = WeighStable(*devices->scale, config_.station.scale, ctx.cancel);
+    std::lock_guard lock(devices_mutex_);
+    if (!weighed) {
+        if (weighed.error().code == ErrorCode::kScaleError) {
+            spdlog::error("scale: {}", weighed.error().message);
+            scale_error_ = weighed.error();
+        }
+        return weighed.error();
+    }
+    scale_error_.reset();
+    return std::optional<Weighing>(std::move(*weighed));
+}
+
 JobOutput DeviceStation::Measure(const JobContext& ctx) {
+    // The parcel is weighed at rest, before the table turns (a turning table shakes the
+    // platform); a scale that cannot weigh ends the run before it starts.
+    Result<std::optional<Weighing>> weighing = Weigh(ctx);
+    if (!weighing) return FailedOutput(weighing.error().code, weighing.error().message);
     double capture_ms = 0.0;
     std::unique_ptr<PosePreparer> preparer;
     Result<Session> session = Capture(ctx, capture_ms, &preparer);
@@ -242,7 +272,8 @@ JobOutput DeviceStation::Measure(const JobContext& ctx) {
     out.result.quality.stop_reason = stopped_early ? "target_uncertainty" : "pose_budget";
     // From the last frame to the result: what the overlap shortens.
     out.result.timing_ms["processing"] = MsSince(last_frame_at_);
-    AddBilling(out.result, config_.billing, std::nullopt);
+    out.result.weight = *weighing;
+    AddBilling(out.result, config_.billing, *weighing);
     if (!measured->cloud.empty()) {
         const auto ply = ctx.scratch_dir / "cloud.ply";
         if (Status s = WritePly(ply, measured->cloud); s) {
@@ -280,7 +311,11 @@ DeviceHealth DeviceStation::Devices() const {
                     open || closed_by(ErrorCode::kCameraError, turntable_description_)},
         DeviceState{config_.station.camera.driver, camera_description_,
                     open || closed_by(ErrorCode::kTurntableError, camera_description_)},
-        device_error_,
+        config_.station.scale.enabled()
+            ? std::optional<DeviceState>(DeviceState{config_.station.scale.driver,
+                                                     scale_description_, open && !scale_error_})
+            : std::nullopt,
+        scale_error_ && !device_error_ ? scale_error_ : device_error_,
     };
 }
 

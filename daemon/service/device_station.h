@@ -65,6 +65,9 @@ private:
     // Captures a session; with a `preparer`, each pose is handed to it as soon as it is grabbed.
     Result<Session> Capture(const JobContext& ctx, double& capture_ms,
                             std::unique_ptr<PosePreparer>* preparer = nullptr);
+    // Weighs the parcel with the station's scale once it is stable (progress "weighing"):
+    // nullopt without a scale, SCALE_ERROR when it cannot.
+    Result<std::optional<Weighing>> Weigh(const JobContext& ctx);
     // Puts the calibration stored in calibration_file in force when it is newer than the
     // config file's.
     void LoadStoredCalibration();
@@ -85,6 +88,8 @@ private:
     std::optional<Error> device_error_;
     std::string turntable_description_;
     std::string camera_description_;
+    std::string scale_description_;
+    std::optional<Error> scale_error_;          // the last weighing's, until one succeeds
     std::filesystem::path calibration_source_;  // the file the calibration in force came from
     // When the calibration in force was made and the run that made it (POST /v1/calibrate's:
     // reference, quality, uncertainty); "" and null for a config's calibration section.

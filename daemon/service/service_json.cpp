@@ -25,6 +25,7 @@ json ToJson(const Error& error) {
 json ToJson(const DeviceHealth& devices) {
     return {{"turntable", DeviceJson(devices.turntable)},
             {"camera", DeviceJson(devices.camera)},
+            {"scale", devices.scale ? DeviceJson(*devices.scale) : json(nullptr)},
             {"error", devices.error ? ToJson(*devices.error) : json(nullptr)}};
 }
 

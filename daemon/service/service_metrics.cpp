@@ -123,14 +123,18 @@ void ServiceMetrics::RecordMeasurement(const MeasurementResult& r) {
     if (auto t = r.timing_ms.find("processing"); t != r.timing_ms.end()) {
         processing_.Observe(t->second / 1e3);
     }
-    if (r.reason && r.reason->code == ErrorCode::kTurntableError) ++turntable_faults_;
-    if (r.reason && r.reason->code == ErrorCode::kCameraError) ++camera_faults_;
+    if (r.reason) CountFault(r.reason->code);
 }
 
 void ServiceMetrics::RecordFault(ErrorCode code) {
     std::lock_guard lock(mutex_);
+    CountFault(code);
+}
+
+void ServiceMetrics::CountFault(ErrorCode code) {
     if (code == ErrorCode::kTurntableError) ++turntable_faults_;
     if (code == ErrorCode::kCameraError) ++camera_faults_;
+    if (code == ErrorCode::kScaleError) ++scale_faults_;
 }
 
 std::string ServiceMetrics::Text(const MetricsContext& context) const {
@@ -164,11 +168,13 @@ std::string ServiceMetrics::Text(const MetricsContext& context) const {
                     "A measurement's processing after the last frame.", processing_);
 
     Header(out, "boxd_device_faults_total", "counter",
-           "Turntable and camera faults (in measurements, calibrations and opening the devices).");
+           "Turntable, camera and scale faults (in measurements, calibrations and opening the "
+           "devices).");
     Sample(out, "boxd_device_faults_total", "device=\"turntable\"",
            static_cast<double>(turntable_faults_));
     Sample(out, "boxd_device_faults_total", "device=\"camera\"",
            static_cast<double>(camera_faults_));
+    Sample(out, "boxd_device_faults_total", "device=\"scale\"", static_cast<double>(scale_faults_));
 
     Header(out, "boxd_calibrated", "gauge", "1 when a station calibration is in force.");
     Sample(out, "boxd_calibrated", "", context.calibrated ? 1 : 0);

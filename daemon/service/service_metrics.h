@@ -1,6 +1,6 @@
 #pragma once
 // ServiceMetrics: the counters behind GET /metrics — measurements by status and by reason code,
-// the cycle and processing time histograms, and the turntable and camera faults — and their
+// the cycle and processing time histograms, and the turntable, camera and scale faults — and their
 // Prometheus text exposition (format 0.0.4). Thread-safe: the measurement worker records, HTTP
 // threads read.
 
@@ -57,11 +57,14 @@ public:
     std::string Text(const MetricsContext& context) const;
 
 private:
+    // Counts a device fault of `code` (turntable, camera, scale); the caller holds mutex_.
+    void CountFault(ErrorCode code);
+
     mutable std::mutex mutex_;
     std::map<std::string, long long> by_status_;
     std::map<std::pair<std::string, std::string>, long long> by_reason_;  // status, code
     Histogram cycle_, processing_;
-    long long turntable_faults_ = 0, camera_faults_ = 0;
+    long long turntable_faults_ = 0, camera_faults_ = 0, scale_faults_ = 0;
 };
 
 }  // namespace boxd

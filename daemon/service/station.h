@@ -54,7 +54,8 @@ struct DeviceState {
 struct DeviceHealth {
     DeviceState turntable;
     DeviceState camera;
-    std::optional<Error> error;  // the last device error; a successful Open() clears it
+    std::optional<DeviceState> scale;  // a station with a scale
+    std::optional<Error> error;        // the last device error; a successful Open() clears it
 };
 
 // The calibration in force (GET /v1/calibration).

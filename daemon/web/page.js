@@ -134,6 +134,11 @@ async function openMeasurement(id) {
     }
     row(dims, [["Volume"], [`${(d.volume_m3 * 1000).toFixed(2)} L`, "value"], [""]]);
     row(dims, [["Shape"], [m.shape || ""], [""]]);
+    const w = m.weight;
+    if (w) {
+      row(dims, [["Weight"], [w.value != null ? `${w.value} ${w.unit}` : "—", "value"],
+                 [w.value != null ? `e = ${w.division} ${w.unit}` : w.why_not]]);
+    }
     text($("last-note"), `${m.status}, ${m.quality.poses} poses, ${when}`);
     showBilling(m.billing);
   } else {

@@ -1,22 +1,16 @@
 #include "drivers/sim/turntable_simulator.h"
 
-#include <arpa/inet.h>
 #include <modbus/modbus.h>
-#include <netinet/in.h>
 #include <spdlog/spdlog.h>
-#include <sys/select.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <thread>
 #include <utility>
 #include <vector>
 
 #include "drivers/sim/modbus_request.h"
+#include "drivers/sim/modbus_server.h"
 #include "drivers/sim/simulated_drive.h"
 #include "drivers/turntable_profile.h"
 
@@ -28,9 +22,6 @@ namespace {
 const TurntableProfile kProfile;
 constexpr int kRegisterCount = 110;
 constexpr int kFirstSpecialRegister = 100;
-constexpr int kPollSliceMs = 10;
-
-Error SimError(const std::string& message) { return Error{ErrorCode::kInvalidInput, message}; }
 
 }  // namespace
 
@@ -39,12 +30,8 @@ struct TurntableSimulator::Impl {
 
     TurntableSimulatorConfig config;
     SimulatedDrive drive;
-    modbus_t* ctx = nullptr;
+    ModbusServer server{"sim-turntable"};
     modbus_mapping_t* map = nullptr;
-    bool rtu = false;
-    int listen_fd = -1;
-    int port = 0;
-    std::vector<int> clients;
 
     int moves_since_arm = 0;    // move commands since the fault was (re)armed
     bool move_faulted = false;  // the move in progress is a faulted one
@@ -52,7 +39,6 @@ struct TurntableSimulator::Impl {
     uint16_t move_count = 0;
     uint16_t stop_count = 0;
     uint16_t home_count = 0;
-    uint16_t connection_count = 0;
 
     uint16_t* regs() { return map->tab_registers; }
 
@@ -87,7 +73,7 @@ struct TurntableSimulator::Impl {
         regs()[kSimSlowReplyMsRegister] = static_cast<uint16_t>(config.slow_reply_ms);
         regs()[kSimMoveCountRegister] = move_count;
         regs()[kSimStopCountRegister] = stop_count;
-        regs()[kSimConnectionCountRegister] = connection_count;
+        regs()[kSimConnectionCountRegister] = static_cast<uint16_t>(server.connections_accepted());
         regs()[kSimHomeCountRegister] = home_count;
     }
 
@@ -185,7 +171,7 @@ struct TurntableSimulator::Impl {
 
     // Serves one request received on the current socket. Returns false when the connection
     // is to be closed (an injected drop).
-    bool Handle(const uint8_t* req, int length) {
+    bool Handle(modbus_t* ctx, const uint8_t* req, int length) {
         Publish();
         const DecodedRequest d = DecodeModbusRequest(req, length, modbus_get_header_length(ctx));
         const bool drive_register = d.lowest_register < kFirstSpecialRegister;
@@ -220,87 +206,6 @@ struct TurntableSimulator::Impl {
         }
         return false;
     }
-
-    void CloseClient(std::size_t i) {
-        close(clients[i]);
-        clients.erase(clients.begin() + static_cast<std::ptrdiff_t>(i));
-    }
-
-    Status ServeTcpOnce() {
-        fd_set readable;
-        FD_ZERO(&readable);
-        FD_SET(listen_fd, &readable);
-        int max_fd = listen_fd;
-        for (int fd : clients) {
-            FD_SET(fd, &readable);
-            max_fd = std::max(max_fd, fd);
-        }
-        timeval timeout{0, kPollSliceMs * 1000};
-        const int n = select(max_fd + 1, &readable, nullptr, nullptr, &timeout);
-        if (n < 0) {
-            if (errno == EINTR) return OkStatus();
-            return Error{ErrorCode::kInternal,
-                         std::string("sim-turntable: select: ") + strerror(errno)};
-        }
-        Publish();
-        if (n == 0) return OkStatus();
-        if (FD_ISSET(listen_fd, &readable)) {
-            sockaddr_in peer{};
-            socklen_t len = sizeof(peer);
-            const int fd = accept(listen_fd, reinterpret_cast<sockaddr*>(&peer), &len);
-            if (fd >= 0) {
-                clients.push_back(fd);
-                ++connection_count;
-                spdlog::info("sim-turntable: client connected from {}:{}", inet_ntoa(peer.sin_addr),
-                             ntohs(peer.sin_port));
-            }
-        }
-        uint8_t query[MODBUS_TCP_MAX_ADU_LENGTH];
-        for (std::size_t i = 0; i < clients.size();) {
-            const int fd = clients[i];
-            if (!FD_ISSET(fd, &readable)) {
-                ++i;
-                continue;
-            }
-            modbus_set_socket(ctx, fd);
-            const int rc = modbus_receive(ctx, query);
-            if (rc > 0 && Handle(query, rc)) {
-                ++i;
-            } else if (rc == 0) {
-                ++i;
-            } else {
-                if (rc < 0) spdlog::info("sim-turntable: client disconnected");
-                CloseClient(i);
-            }
-        }
-        return OkStatus();
-    }
-
-    Status ServeRtuOnce() {
-        const int fd = modbus_get_socket(ctx);
-        fd_set readable;
-        FD_ZERO(&readable);
-        FD_SET(fd, &readable);
-        timeval timeout{0, kPollSliceMs * 1000};
-        const int n = select(fd + 1, &readable, nullptr, nullptr, &timeout);
-        if (n < 0) {
-            if (errno == EINTR) return OkStatus();
-            return Error{ErrorCode::kInternal,
-                         std::string("sim-turntable: select: ") + strerror(errno)};
-        }
-        Publish();
-        if (n == 0) return OkStatus();
-        uint8_t query[MODBUS_RTU_MAX_ADU_LENGTH];
-        const int rc = modbus_receive(ctx, query);
-        if (rc > 0) {
-            // On a serial line a "dropped connection" is a reply that never comes.
-            Handle(query, rc);
-        } else if (rc < 0) {
-            spdlog::debug("sim-turntable: bad frame: {}", modbus_strerror(errno));
-            modbus_flush(ctx);
-        }
-        return OkStatus();
-    }
 };
 
 TurntableSimulator::TurntableSimulator(const TurntableSimulatorConfig& config)
@@ -310,12 +215,6 @@ TurntableSimulator::TurntableSimulator(const TurntableSimulatorConfig& config)
 }
 
 TurntableSimulator::~TurntableSimulator() {
-    for (int fd : impl_->clients) close(fd);
-    if (impl_->listen_fd >= 0) close(impl_->listen_fd);
-    if (impl_->ctx) {
-        if (impl_->rtu) modbus_close(impl_->ctx);
-        modbus_free(impl_->ctx);
-    }
     if (impl_->map) modbus_mapping_free(impl_->map);
 }
 
@@ -323,56 +222,32 @@ Status TurntableSimulator::ListenTcp(const std::string& host, int port) {
     if (auto st = impl_->config.Validate(); !st) return st;
     if (!impl_->map)
         return Error{ErrorCode::kInternal, "sim-turntable: cannot allocate the registers"};
-    impl_->ctx = modbus_new_tcp(host.c_str(), port);
-    if (!impl_->ctx) {
-        return SimError("sim-turntable: bad listen address " + host + ":" + std::to_string(port));
-    }
-    impl_->listen_fd = modbus_tcp_listen(impl_->ctx, 8);
-    if (impl_->listen_fd < 0) {
-        return Error{ErrorCode::kInternal, "sim-turntable: cannot listen on " + host + ":" +
-                                               std::to_string(port) + ": " +
-                                               modbus_strerror(errno)};
-    }
-    sockaddr_in bound{};
-    socklen_t len = sizeof(bound);
-    getsockname(impl_->listen_fd, reinterpret_cast<sockaddr*>(&bound), &len);
-    impl_->port = ntohs(bound.sin_port);
-    spdlog::info("sim-turntable: listening on {}:{} (Modbus TCP)", host, impl_->port);
-    return OkStatus();
+    return impl_->server.ListenTcp(host, port);
 }
 
-int TurntableSimulator::port() const { return impl_->port; }
+int TurntableSimulator::port() const { return impl_->server.port(); }
 
 Status TurntableSimulator::OpenRtu(const std::string& device, int baud, char parity, int data_bits,
                                    int stop_bits) {
     if (auto st = impl_->config.Validate(); !st) return st;
     if (!impl_->map)
         return Error{ErrorCode::kInternal, "sim-turntable: cannot allocate the registers"};
-    impl_->rtu = true;
-    impl_->ctx = modbus_new_rtu(device.c_str(), baud, parity, data_bits, stop_bits);
-    if (!impl_->ctx) {
-        return SimError("sim-turntable: bad serial settings for " + device + ": " +
-                        modbus_strerror(errno));
-    }
-    modbus_set_slave(impl_->ctx, impl_->config.slave_id);
-    if (modbus_connect(impl_->ctx) == -1) {
-        return Error{ErrorCode::kInternal,
-                     "sim-turntable: cannot open " + device + ": " + modbus_strerror(errno)};
-    }
-    spdlog::info("sim-turntable: serving Modbus RTU on {} ({} baud, slave {})", device, baud,
-                 impl_->config.slave_id);
-    return OkStatus();
+    return impl_->server.OpenRtu(device, baud, parity, data_bits, stop_bits,
+                                 impl_->config.slave_id);
 }
 
 Status TurntableSimulator::Serve(const std::atomic<bool>& stop) {
-    if (!impl_->ctx) return Error{ErrorCode::kInternal, "sim-turntable: not listening"};
-    while (!stop.load()) {
-        auto st = impl_->rtu ? impl_->ServeRtuOnce() : impl_->ServeTcpOnce();
-        if (!st) return st;
-    }
+    Impl& impl = *impl_;
+    Status served = impl.server.Serve(
+        stop,
+        [&impl](modbus_t* ctx, const uint8_t* req, int length) {
+            return impl.Handle(ctx, req, length);
+        },
+        [&impl] { impl.Publish(); });
+    if (!served) return served;
     spdlog::info("sim-turntable: stopping (table {})",
-                 impl_->drive.status().moving ? "was moving, stopped" : "at rest");
-    impl_->drive.Stop(SimClock::now());
+                 impl.drive.status().moving ? "was moving, stopped" : "at rest");
+    impl.drive.Stop(SimClock::now());
     return OkStatus();
 }
 

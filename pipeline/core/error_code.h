@@ -55,6 +55,7 @@ enum class ErrorCategory {
     X(kNotConverged, "NOT_CONVERGED", kCalibrationRefused)        \
     X(kCameraError, "CAMERA_ERROR", kDevice)                      \
     X(kTurntableError, "TURNTABLE_ERROR", kDevice)                \
+    X(kScaleError, "SCALE_ERROR", kDevice)                        \
     X(kCancelled, "CANCELLED", kInterrupted)                      \
     X(kAborted, "ABORTED", kInterrupted)                          \
     X(kShuttingDown, "SHUTTING_DOWN", kUnavailable)               \

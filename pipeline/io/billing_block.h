@@ -15,6 +15,7 @@ namespace boxd {
 enum class BillingUnits { kMetric, kImperial };  // mm, cm³, kg | in, in³, lb
 
 inline constexpr double kMetresPerInch = 0.0254;
+inline constexpr double kKgPerLb = 0.45359237;
 // The billed dimensions in their order, as the block names them.
 inline constexpr std::array<const char*, 3> kBilledDimensions{"length", "width", "height"};
 

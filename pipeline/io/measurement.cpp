@@ -135,6 +135,7 @@ json ToJson(const MeasurementResult& m) {
     json timing = json::object();
     for (const auto& [stage, ms] : m.timing_ms) timing[stage] = Round(ms, 0.1);
     j["timing_ms"] = timing;
+    if (m.weight) j["weight"] = ToJson(*m.weight);
     if (m.billing) j["billing"] = ToJson(*m.billing);
     return j;
 }

@@ -9,6 +9,7 @@
 
 #include "pipeline/core/result.h"
 #include "pipeline/io/billing_block.h"
+#include "pipeline/io/weight_block.h"
 
 namespace boxd {
 
@@ -85,6 +86,9 @@ struct MeasurementResult {
     // The station's billing of the dimensions (a station with a `billing:` section, a measured
     // object); an addition to SPEC section 5.
     std::optional<Billing> billing;
+    // What the station's scale weighed (a station with a `scale:`); an addition to SPEC
+    // section 5.
+    std::optional<Weighing> weight;
 };
 
 const char* StatusName(MeasurementStatus s);

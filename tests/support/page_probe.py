@@ -43,6 +43,7 @@ PROBE = r"""JSON.stringify((() => {
     back_shown: !$('back-to-latest').hidden, clock_note: $('clock-note').textContent,
     calibration: $('calibration-facts').textContent, history_text: $('history-table').textContent,
     billing: $('billing').hidden ? null : $('billing').textContent,
+    dims: $('dims').textContent,
   };
 })())"""
 

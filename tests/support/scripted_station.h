@@ -56,6 +56,7 @@ public:
         out.result.quality.poses = 4;
         // A station that bills, weighed at 2.5 kg (the block's schema is checked on it).
         out.result.billing = Bill({0.4, 0.3, 0.2}, {0.001, 0.001, 0.001}, 2.5, BillingConfig{});
+        out.result.weight = Weighing{2.5, "", "kg", 0.005, 520.0, 11, "scripted indicator"};
         const auto ply = ctx.scratch_dir / "cloud.ply";
         std::ofstream(ply) << "ply\nformat ascii 1.0\nelement vertex 0\nend_header\n";
         out.files.cloud_ply = ply;

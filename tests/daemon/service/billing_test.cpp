@@ -90,9 +90,28 @@ TEST(Bill, DimensionalWeightsPerCarrierRoundUpToTheirDivision) {
     ASSERT_TRUE(b.billable) << b.reason;
     EXPECT_NEAR(b.carriers[0].dimensional_weight, 4.9, 1e-9);
     EXPECT_NEAR(b.carriers[1].dimensional_weight, 4.1, 1e-9);
-    // The billable weight is the larger of the actual and the dimensional.
+    // The billable weight is the larger of the actual and the dimensional, each rounded up to
+    // the weight division: 4.87 kg bills as 4.9.
     EXPECT_NEAR(*b.carriers[0].billable_weight, 4.9, 1e-9);
-    EXPECT_NEAR(*b.carriers[1].billable_weight, 4.87, 1e-9);
+    EXPECT_NEAR(*b.carriers[1].billable_weight, 4.9, 1e-9);
+    b = Bill({0.405, 0.3, 0.2}, {0.001, 0.001, 0.001}, 4.8, Metric(BillingRounding::kNearest));
+    EXPECT_NEAR(*b.carriers[1].billable_weight, 4.8, 1e-9);  // on the division: unchanged
+}
+
+TEST(Bill, TheScalesWeightComesInTheBillingsUnits) {
+    Weighing w;
+    w.value = 2.5;
+    w.unit = "kg";
+    EXPECT_NEAR(*ActualWeight(w, BillingUnits::kMetric), 2.5, 1e-12);
+    EXPECT_NEAR(*ActualWeight(w, BillingUnits::kImperial), 5.51155655, 1e-8);
+    w.unit = "lb";
+    EXPECT_NEAR(*ActualWeight(w, BillingUnits::kMetric), 1.133980925, 1e-9);
+    EXPECT_NEAR(*ActualWeight(w, BillingUnits::kImperial), 2.5, 1e-12);
+    // Below the scale's minimum load no weight is stated, and none is billed.
+    w.value.reset();
+    w.why_not = "0.06 kg is below the scale's minimum load of 0.1 kg";
+    EXPECT_FALSE(ActualWeight(w, BillingUnits::kMetric).has_value());
+    EXPECT_FALSE(ActualWeight(std::nullopt, BillingUnits::kMetric).has_value());
 }
 
 TEST(Bill, ImperialInFifthsOfAnInchAndPoundsPerCubicInch) {

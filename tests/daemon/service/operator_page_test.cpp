@@ -109,6 +109,13 @@ TEST(OperatorPage, FitsPhoneTabletAndDesktopAndShowsWhatIsMeasuredNow) {
         << billing;
     EXPECT_NE(billing.find("express"), std::string::npos) << billing;
     EXPECT_NE(billing.find("air"), std::string::npos) << billing;
+    // Its scale weighed the parcel: the weight stands with the dimensions, and the billing
+    // weighed it.
+    ASSERT_TRUE(second.contains("weight")) << second.dump();
+    const std::string weight = second["weight"]["value"].dump() + " kg";
+    EXPECT_NE(desktop["dims"].get<std::string>().find("Weight" + weight), std::string::npos)
+        << desktop["dims"];
+    EXPECT_NE(billing.find("weighed" + weight), std::string::npos) << billing;
 
     // While the next parcel is measured: the live panel, the previous result dimmed and named.
     const json& measuring = steps[6];

@@ -46,6 +46,8 @@ TEST(ServiceMetrics, CountsByStatusAndReasonAndTimesInCumulativeBuckets) {
     metrics.RecordMeasurement(
         Finished(MeasurementStatus::kFailed, ErrorCode::kTurntableError, 500, 0));
     metrics.RecordFault(ErrorCode::kCameraError);
+    metrics.RecordFault(ErrorCode::kScaleError);
+    metrics.RecordFault(ErrorCode::kScaleError);
     metrics.RecordFault(ErrorCode::kWrongReference);  // not a device fault: ignored
     MetricsContext context;
     context.state = "error";
@@ -61,6 +63,7 @@ TEST(ServiceMetrics, CountsByStatusAndReasonAndTimesInCumulativeBuckets) {
               1);
     EXPECT_EQ(s.at("boxd_device_faults_total{device=\"turntable\"}"), 1);
     EXPECT_EQ(s.at("boxd_device_faults_total{device=\"camera\"}"), 1);
+    EXPECT_EQ(s.at("boxd_device_faults_total{device=\"scale\"}"), 2);
     // Cycle 0.5, 2.8, 3.0, 4.1 s: cumulative counts at each bound.
     EXPECT_EQ(s.at("boxd_measurement_cycle_seconds_bucket{le=\"0.25\"}"), 0);
     EXPECT_EQ(s.at("boxd_measurement_cycle_seconds_bucket{le=\"0.5\"}"), 1);
