@@ -17,6 +17,8 @@ namespace boxd::cli {
 inline constexpr int kExitOk = 0;
 inline constexpr int kExitInternal = 1;
 inline constexpr int kExitNoDim = 3;  // measured, status no_dim, the JSON is on stdout
+// boxd verify: a stored record was changed or deleted (an addition to SPEC section 4).
+inline constexpr int kExitVerifyFailed = 4;
 
 // Set by the chosen subcommand's callback; main() runs it after parsing.
 using Runner = std::function<int()>;
@@ -29,6 +31,7 @@ void AddSynth(CLI::App& app, Runner& run);
 void AddSimTurntable(CLI::App& app, Runner& run);
 void AddDevices(CLI::App& app, Runner& run);
 void AddBenchMeasure(CLI::App& app, Runner& run);
+void AddVerify(CLI::App& app, Runner& run);
 
 // Returns "boxd 0.1.0 (commit b3d8619a2f4c, Release build)".
 std::string VersionText();

@@ -4,9 +4,11 @@
 #include <CLI/CLI.hpp>
 #include <memory>
 
+#include "daemon/cli/build_info.h"
 #include "daemon/cli/cli.h"
 #include "daemon/service/serve_config.h"
 #include "daemon/service/service_loop.h"
+#include "daemon/service/sha256.h"
 
 namespace boxd::cli {
 
@@ -31,7 +33,10 @@ int RunServe(const ServeOptions& o) {
     if (!o.data_dir.empty()) overrides.data_dir = o.data_dir;
     auto config = LoadServeConfig(o.config, overrides);
     if (!config) return Fail(config.error());
-    Status served = RunService(std::move(*config), o.config, overrides);
+    auto sha256 = Sha256OfFile("/proc/self/exe");
+    if (!sha256) return Fail(sha256.error());
+    const SoftwareIdentity software{BuildVersion(), BuildCommit(), *sha256};
+    Status served = RunService(std::move(*config), o.config, overrides, software);
     return served ? kExitOk : Fail(served.error());
 }
 

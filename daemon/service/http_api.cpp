@@ -159,9 +159,31 @@ void AddStatusRoutes(RouteTable& routes, const ApiContext& api) {
                    const ServiceSnapshot snapshot = api.service.Snapshot();
                    const std::shared_ptr<Station> station = api.service.station();
                    const long long uptime_s = UptimeSeconds();
-                   SetJson(
-                       res, 200,
-                       StatusJson(snapshot, station->Devices(), station->Calibration(), uptime_s));
+                   json j =
+                       StatusJson(snapshot, station->Devices(), station->Calibration(), uptime_s);
+                   const std::optional<AuditStatus> audit =
+                       api.audit_status ? api.audit_status() : std::nullopt;
+                   j["audit"] = audit ? ToJson(*audit) : json(nullptr);
+                   SetJson(res, 200, j);
+               }));
+
+    // The metrological events, newest first.
+    routes.Get("/v1/audit", Guarded([api](const Request& req, Response& res) {
+                   const std::optional<int> limit = LimitParam(req, res, 100);
+                   if (!limit) return;
+                   if (!api.audit_trail) {
+                       SetJson(res, 200, json{{"event_counter", 0}, {"events", json::array()}});
+                       return;
+                   }
+                   auto events = api.audit_trail->Events(*limit);
+                   if (!events) {
+                       SetError(res, events.error());
+                       return;
+                   }
+                   json list = json::array();
+                   for (const AuditEvent& e : *events) list.push_back(ToJson(e));
+                   SetJson(res, 200,
+                           json{{"event_counter", api.audit_trail->Counter()}, {"events", list}});
                }));
 
     routes.Get("/v1/openapi.json", Guarded([](const Request&, Response& res) {
@@ -179,6 +201,7 @@ void AddStatusRoutes(RouteTable& routes, const ApiContext& api) {
                    if (context.calibrated) context.calibration_age_s = calibration.age_s;
                    context.uptime_s = UptimeSeconds();
                    if (api.mqtt_stats) context.mqtt = api.mqtt_stats();
+                   if (api.audit_status) context.audit = api.audit_status();
                    res.status = 200;
                    res.set_content(api.service.metrics().Text(context),
                                    "text/plain; version=0.0.4; charset=utf-8");
@@ -222,7 +245,8 @@ void HttpApi::Register(httplib::Server& server) {
         spdlog::debug("http {} {} -> {}", req.method, req.path, res.status);
     });
 
-    const ApiContext api{config_, service_, store_, loop_alive_, mqtt_stats_};
+    const ApiContext api{config_,     service_,     store_,       loop_alive_,
+                         mqtt_stats_, audit_trail_, audit_status_};
     AddStatusRoutes(*routes, api);
     AddMeasurementRoutes(*routes, api);
     AddCalibrationRoutes(*routes, api);

@@ -6,8 +6,8 @@
 
 #include <functional>
 #include <memory>
-#include <optional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -44,6 +44,13 @@ public:
     void set_mqtt_stats(std::function<std::optional<MqttStats>()> stats) {
         mqtt_stats_ = std::move(stats);
     }
+    // Adds the audit trail: GET /v1/audit lists its events, and `status` (what the trail, the
+    // software and the records' chain say) goes into GET /v1/status and GET /metrics; call
+    // before Start().
+    void set_audit(AuditTrail* trail, std::function<std::optional<AuditStatus>()> status) {
+        audit_trail_ = trail;
+        audit_status_ = std::move(status);
+    }
     // Returns the bound TCP port (the configured one, or the one picked for port 0), or 0.
     int tcp_port() const { return tcp_port_; }
 
@@ -55,6 +62,8 @@ private:
     MeasurementStore& store_;
     std::function<bool()> loop_alive_;
     std::function<std::optional<MqttStats>()> mqtt_stats_;
+    AuditTrail* audit_trail_ = nullptr;
+    std::function<std::optional<AuditStatus>()> audit_status_;
     std::vector<std::unique_ptr<httplib::Server>> servers_;
     std::vector<std::thread> threads_;
     int tcp_port_ = 0;

@@ -78,21 +78,14 @@ void PostMeasure(const ApiContext& api, const Request& req, Response& res) {
 
 // GET /v1/measurements?limit=N[&parcel_id=P].
 void ListMeasurements(const ApiContext& api, const Request& req, Response& res) {
-    int limit = 20;
-    if (req.has_param("limit")) {
-        const std::string v = req.get_param_value("limit");
-        const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), limit);
-        if (ec != std::errc() || end != v.data() + v.size() || limit < 1 || limit > 1000) {
-            SetError(res, ErrorCode::kBadRequest, "limit must be an integer in 1..1000");
-            return;
-        }
-    }
+    const std::optional<int> limit = LimitParam(req, res, 20);
+    if (!limit) return;
     std::optional<std::string> parcel_id;
     if (req.has_param("parcel_id")) {
         parcel_id = ParcelIdField(json(req.get_param_value("parcel_id")), res);
         if (!parcel_id) return;
     }
-    auto list = api.store.List(limit, parcel_id);
+    auto list = api.store.List(*limit, parcel_id);
     if (!list) {
         SetError(res, list.error());
         return;

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <charconv>
 #include <exception>
 #include <fstream>
 #include <sstream>
@@ -44,6 +45,18 @@ httplib::Server::Handler Guarded(std::function<void(const Request&, Response&)> 
             SetError(res, ErrorCode::kInternal, "unknown failure");
         }
     };
+}
+
+std::optional<int> LimitParam(const Request& req, Response& res, int fallback) {
+    if (!req.has_param("limit")) return fallback;
+    const std::string v = req.get_param_value("limit");
+    int limit = 0;
+    const auto [end, ec] = std::from_chars(v.data(), v.data() + v.size(), limit);
+    if (ec != std::errc() || end != v.data() + v.size() || limit < 1 || limit > 1000) {
+        SetError(res, ErrorCode::kBadRequest, "limit must be an integer in 1..1000");
+        return std::nullopt;
+    }
+    return limit;
 }
 
 std::optional<bool> BoolParam(const Request& req, const char* name) {

@@ -39,6 +39,9 @@ std::string ReadFile(const std::filesystem::path& path, bool& ok);
 // Returns the value of a boolean query parameter ("1"/"true"/""/"0"/"false"; false when absent),
 // or nullopt when it has another value.
 std::optional<bool> BoolParam(const httplib::Request& req, const char* name);
+// Returns the `limit` query parameter (`fallback` when absent), or answers 400 BAD_REQUEST and
+// returns nullopt when it is not an integer in 1..1000.
+std::optional<int> LimitParam(const httplib::Request& req, httplib::Response& res, int fallback);
 
 // Returns the request's JSON object body ({} when empty and not `required`), or answers 400
 // BAD_REQUEST and returns nullopt: a body that is not a JSON object, or one with a key not in

@@ -5,6 +5,7 @@
 #include <functional>
 #include <optional>
 
+#include "daemon/service/audit_trail.h"
 #include "daemon/service/daemon_config.h"
 #include "daemon/service/measurement_service.h"
 #include "daemon/service/measurement_store.h"
@@ -20,9 +21,12 @@ struct ApiContext {
     MeasurementStore& store;
     const std::function<bool()>& loop_alive;  // GET /v1/health: the service loop still runs
     const std::function<std::optional<MqttStats>()>& mqtt_stats;  // GET /metrics; may be empty
+    // The audit trail (GET /v1/audit) and what status and metrics say of it; may be null/empty.
+    AuditTrail* audit_trail;
+    const std::function<std::optional<AuditStatus>()>& audit_status;
 };
 
-// GET /v1/health, GET /v1/status, GET /v1/openapi.json, GET /metrics.
+// GET /v1/health, GET /v1/status, GET /v1/audit, GET /v1/openapi.json, GET /metrics.
 void AddStatusRoutes(RouteTable& routes, const ApiContext& api);
 // POST /v1/measure, GET /v1/measurements, /v1/measurements/{id} (and "last"),
 // /v1/measurements/{id}/cloud.ply.

@@ -261,6 +261,7 @@ void MeasurementService::Run(std::string id, std::filesystem::path scratch,
     r.parcel_id = std::move(parcel_id);
     r.started_at = started_at;
     r.finished_at = UtcTimestampNow();
+    r.software = software_;
     r.timing_ms["total"] =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (cancel_ && r.status != MeasurementStatus::kOk) {

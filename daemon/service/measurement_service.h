@@ -90,6 +90,9 @@ public:
     // (OpenStation...()).
     Status ReplaceStation(std::shared_ptr<Station> station, bool keep_sessions);
 
+    // The program's identification, put in every finished measurement. Set before the first
+    // measurement starts.
+    void set_software(SoftwareIdentity software) { software_ = std::move(software); }
     // Called (from any thread) whenever the state or the progress changes.
     void set_on_change(std::function<void()> on_change);
     // Called (from the measurement's thread) with every finished measurement, once it is
@@ -143,6 +146,7 @@ private:
     std::thread worker_;
     std::function<void()> on_change_;
     std::function<void(const MeasurementResult&)> on_finished_;
+    std::optional<SoftwareIdentity> software_;
     std::unique_ptr<CalibrationHistory> history_;
     ServiceMetrics metrics_;  // null when it could not be opened
 };

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "daemon/service/record_chain.h"
 #include "daemon/service/sqlite_db.h"
 #include "pipeline/core/json_text.h"
 
@@ -69,6 +70,66 @@ Result<std::optional<json>> ParseStored(const std::string& text, const std::stri
     return std::optional<json>(std::move(j));
 }
 
+// A record retention removes, and its files.
+struct Doomed {
+    std::string id, cloud_file, session_dir, hash;
+};
+
+// Inserts `result`'s row linked to the chain's head and makes it the head; in a transaction.
+Status InsertChained(sqlite3* db, const MeasurementResult& result, long long seq,
+                     const std::optional<std::string>& cloud_file,
+                     const std::optional<std::string>& session_dir) {
+    const std::string& id = result.id;
+    const std::string text = JsonText(ToJson(result));
+    auto prev = ChainHead(db);
+    if (!prev) return prev.error();
+    const std::string hash = ChainHash(*prev, id, text);
+    SqlStatement insert(db,
+                        "INSERT INTO measurements (seq, id, started_at, finished_at, status,"
+                        " result_json, cloud_file, session_dir, parcel_id, prev_hash, hash)"
+                        " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?);");
+    if (!insert.prepared()) return SqlError(db, "cannot prepare the insert");
+    insert.Bind(1, seq);
+    insert.Bind(2, id);
+    insert.Bind(3, result.started_at);
+    insert.Bind(4, result.finished_at);
+    insert.Bind(5, std::string(StatusName(result.status)));
+    insert.Bind(6, text);
+    cloud_file ? insert.Bind(7, *cloud_file) : insert.BindNull(7);
+    session_dir ? insert.Bind(8, *session_dir) : insert.BindNull(8);
+    result.parcel_id ? insert.Bind(9, *result.parcel_id) : insert.BindNull(9);
+    insert.Bind(10, *prev);
+    insert.Bind(11, hash);
+    if (insert.Step() != SQLITE_DONE) return SqlError(db, "cannot store " + id);
+    return SetChainHead(db, hash, seq);
+}
+
+// Deletes the rows beyond the newest `retention` (listing them in `doomed`) and records the
+// newest removed record's hash for the chain; in a transaction.
+Status PruneRows(sqlite3* db, int retention, std::vector<Doomed>& doomed) {
+    long long newest_seq = 0;
+    {
+        SqlStatement q(db,
+                       "SELECT id, cloud_file, session_dir, hash, seq FROM measurements"
+                       " ORDER BY seq DESC LIMIT -1 OFFSET ?;");
+        if (!q.prepared()) return SqlError(db, "cannot prepare the retention query");
+        q.Bind(1, static_cast<long long>(retention));
+        while (q.Step() == SQLITE_ROW) {
+            if (doomed.empty()) newest_seq = q.Int(4);
+            doomed.push_back({q.Text(0), q.Text(1), q.Text(2), q.Text(3)});
+        }
+    }
+    if (doomed.empty()) return OkStatus();
+    if (!doomed.front().hash.empty()) {
+        if (Status s = SetChainPruned(db, doomed.front().hash, newest_seq); !s) return s;
+    }
+    SqlStatement del(db, "DELETE FROM measurements WHERE seq <= ?;");
+    if (!del.prepared()) return SqlError(db, "cannot prepare the retention delete");
+    del.Bind(1, newest_seq);
+    if (del.Step() != SQLITE_DONE) return SqlError(db, "cannot apply the retention limit");
+    return OkStatus();
+}
+
 }  // namespace
 
 MeasurementStore::MeasurementStore(fs::path data_dir, sqlite3* db, int retention)
@@ -107,9 +168,11 @@ Result<std::unique_ptr<MeasurementStore>> MeasurementStore::Open(const fs::path&
                                          "INSERT OR IGNORE INTO id_counter VALUES (1, 0);",
                                      });
     if (!db) return db.error();
-    if (Status s = AddParcelIdColumn(*db); !s) {
-        sqlite3_close(*db);
-        return s.error();
+    for (Status s : {AddParcelIdColumn(*db), AddChainColumns(*db)}) {
+        if (!s) {
+            sqlite3_close(*db);
+            return s.error();
+        }
     }
     std::unique_ptr<MeasurementStore> store(new MeasurementStore(data_dir, *db, retention));
     return store;
@@ -176,45 +239,15 @@ Status MeasurementStore::Save(const MeasurementResult& result, const Measurement
         if (auto s = MoveInto(*files.session_dir, data_dir_ / *session_dir); !s) return s;
     }
 
-    SqlStatement insert(db_,
-                        "INSERT OR REPLACE INTO measurements (seq, id, started_at, finished_at,"
-                        " status, result_json, cloud_file, session_dir, parcel_id)"
-                        " VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?);");
-    if (!insert.prepared()) return SqlError(db_, "cannot prepare the insert");
-    insert.Bind(1, seq);
-    insert.Bind(2, id);
-    insert.Bind(3, result.started_at);
-    insert.Bind(4, result.finished_at);
-    insert.Bind(5, std::string(StatusName(result.status)));
-    insert.Bind(6, JsonText(ToJson(result)));
-    cloud_file ? insert.Bind(7, *cloud_file) : insert.BindNull(7);
-    session_dir ? insert.Bind(8, *session_dir) : insert.BindNull(8);
-    result.parcel_id ? insert.Bind(9, *result.parcel_id) : insert.BindNull(9);
-    if (insert.Step() != SQLITE_DONE) return SqlError(db_, "cannot store " + id);
-    return ApplyRetentionLocked();
-}
-
-Status MeasurementStore::ApplyRetentionLocked() {
-    struct Doomed {
-        std::string id, cloud_file, session_dir;
-    };
+    // The row, its link in the chain and what retention removes commit together.
+    if (auto s = SqlExec(db_, "BEGIN IMMEDIATE;"); !s) return s;
     std::vector<Doomed> doomed;
-    {
-        SqlStatement q(db_,
-                       "SELECT id, cloud_file, session_dir FROM measurements"
-                       " ORDER BY seq DESC LIMIT -1 OFFSET ?;");
-        if (!q.prepared()) return SqlError(db_, "cannot prepare the retention query");
-        q.Bind(1, static_cast<long long>(retention_));
-        while (q.Step() == SQLITE_ROW) doomed.push_back({q.Text(0), q.Text(1), q.Text(2)});
-    }
-    if (doomed.empty()) return OkStatus();
-    {
-        SqlStatement del(db_,
-                         "DELETE FROM measurements WHERE seq IN (SELECT seq FROM measurements"
-                         " ORDER BY seq DESC LIMIT -1 OFFSET ?);");
-        if (!del.prepared()) return SqlError(db_, "cannot prepare the retention delete");
-        del.Bind(1, static_cast<long long>(retention_));
-        if (del.Step() != SQLITE_DONE) return SqlError(db_, "cannot apply the retention limit");
+    Status stored = InsertChained(db_, result, seq, cloud_file, session_dir);
+    if (stored) stored = PruneRows(db_, retention_, doomed);
+    if (stored) stored = SqlExec(db_, "COMMIT;");
+    if (!stored) {
+        (void)SqlExec(db_, "ROLLBACK;");
+        return stored;
     }
     // Rows go first: a file without a row is harmless, a row without its file is not.
     for (const auto& d : doomed) {
@@ -224,6 +257,11 @@ Status MeasurementStore::ApplyRetentionLocked() {
         spdlog::debug("retention: removed measurement {}", d.id);
     }
     return OkStatus();
+}
+
+Result<ChainReport> MeasurementStore::VerifyChain() {
+    std::lock_guard lock(mutex_);
+    return VerifyRecordChain(db_);
 }
 
 Result<std::optional<json>> MeasurementStore::Last() {

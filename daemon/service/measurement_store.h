@@ -3,7 +3,8 @@
 // (data_dir/boxd.db) holds every finished measurement's JSON, read back as stored (the API serves
 // it as is); fused clouds live beside it as PLY files (data_dir/clouds/<id>.ply) and, optionally,
 // captured sessions (data_dir/sessions/<id>/). A row is committed only after its files are in
-// place, so what the database lists is always servable, also after a crash or kill -9. Thread-safe.
+// place, so what the database lists is always servable, also after a crash or kill -9. Every row
+// is a link of a hash chain (record_chain.h) that finds a record changed by hand. Thread-safe.
 
 #include <filesystem>
 #include <memory>
@@ -13,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "daemon/service/record_chain.h"
 #include "pipeline/core/result.h"
 #include "pipeline/io/measurement.h"
 
@@ -62,10 +64,11 @@ public:
     Result<std::optional<std::filesystem::path>> CloudPath(const std::string& id);
     // Returns the number of stored measurements.
     Result<int> Count();
+    // Checks the stored records against their hash chain (daemon/service/record_chain.h).
+    Result<ChainReport> VerifyChain();
 
 private:
     MeasurementStore(std::filesystem::path data_dir, sqlite3* db, int retention);
-    Status ApplyRetentionLocked();
 
     std::filesystem::path data_dir_;
     sqlite3* db_ = nullptr;

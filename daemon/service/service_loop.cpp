@@ -2,12 +2,14 @@
 
 #include <poll.h>
 #include <spdlog/spdlog.h>
+#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <memory>
 
+#include "daemon/service/audit_trail.h"
 #include "daemon/service/http_api.h"
 #include "daemon/service/measurement_service.h"
 #include "daemon/service/measurement_store.h"
@@ -15,7 +17,9 @@
 #include "daemon/service/service_json.h"
 #include "daemon/service/signal_flags.h"
 #include "daemon/service/systemd_notifier.h"
+#include "drivers/station_config.h"
 #include "pipeline/core/json_text.h"
+#include "pipeline/io/station_calibration_json.h"
 
 namespace boxd {
 
@@ -49,16 +53,25 @@ std::string StatusLine(const ServiceSnapshot& s) {
 
 class ServiceLoop {
 public:
-    ServiceLoop(ServeConfig config, std::filesystem::path config_file, ServeOverrides overrides)
+    ServiceLoop(ServeConfig config, std::filesystem::path config_file, ServeOverrides overrides,
+                SoftwareIdentity software)
         : config_(std::move(config)),
           config_file_(std::move(config_file)),
-          overrides_(std::move(overrides)) {}
+          overrides_(std::move(overrides)),
+          software_(std::move(software)) {}
 
     Status Run();
 
 private:
     void Reload();
     void Tick();
+    // Opens the audit trail and checks the stored records' chain (logged, and kept for status).
+    Status OpenAuditTrail();
+    // Records each metrological setting that changed since it was last seen, as coming `via`.
+    void ObserveSettings(const std::string& via);
+    // The calibration in force, as the audit trail compares it.
+    std::string CalibrationText() const;
+    std::optional<AuditStatus> Audit() const;
     std::shared_ptr<Station> MakeStation(const ServeConfig& config) {
         return std::make_shared<DeviceStation>(config.station);
     }
@@ -66,7 +79,11 @@ private:
     ServeConfig config_;
     std::filesystem::path config_file_;
     ServeOverrides overrides_;
+    SoftwareIdentity software_;
     SystemdNotifier notifier_;
+    std::unique_ptr<AuditTrail> audit_;
+    ChainReport chain_;  // the records' chain as checked at start (read by HTTP threads after)
+    std::string chain_checked_at_;
     std::unique_ptr<MeasurementStore> store_;
     std::unique_ptr<MeasurementService> service_;
     std::unique_ptr<HttpApi> api_;
@@ -89,10 +106,13 @@ Status ServiceLoop::Run() {
     auto store = MeasurementStore::Open(config_.storage.data_dir, config_.storage.retention);
     if (!store) return BadConfig("storage.data_dir: " + store.error().message);
     store_ = std::move(*store);
+    if (Status s = OpenAuditTrail(); !s) return s;
 
     service_ = std::make_unique<MeasurementService>(*store_, MakeStation(config_),
                                                     config_.storage.keep_sessions);
+    service_->set_software(software_);
     service_->set_on_change([] { WakeMainLoop(); });
+    ObserveSettings("config file " + config_file_.string() + " at start");
     if (config_.mqtt.enabled) {
         auto mqtt = MqttPublisher::Start(config_.mqtt);
         if (!mqtt) return BadConfig(mqtt.error().message);
@@ -109,6 +129,7 @@ Status ServiceLoop::Run() {
     if (mqtt_) {
         api_->set_mqtt_stats([this]() -> std::optional<MqttStats> { return mqtt_->Stats(); });
     }
+    api_->set_audit(audit_.get(), [this] { return Audit(); });
     if (Status s = api_->Start(); !s) return BadConfig(s.error().message);
 
     // The devices come up on their own thread (`starting`): the loop answers signals meanwhile,
@@ -169,6 +190,9 @@ void ServiceLoop::Tick() {
         if (api_->Running()) notifier_.Watchdog();
         next_watchdog_ = Clock::now() + notifier_.watchdog_interval();
     }
+    // At run time the calibration changes only through POST /v1/calibrate (a reload observes
+    // its own changes first).
+    if (!service_->Busy()) ObserveSettings("POST /v1/calibrate");
     const ServiceSnapshot snapshot = service_->Snapshot();
     if (mqtt_) mqtt_->PublishState(JsonText(MqttStateJson(snapshot, config_.mqtt.station_id)));
     const std::string status = StatusLine(snapshot);
@@ -210,16 +234,73 @@ void ServiceLoop::Reload() {
         return;
     }
     config_ = std::move(*fresh);
+    ObserveSettings("config file " + config_file_.string() + ", SIGHUP reload");
     service_->OpenStationInBackground();
     notifier_.Ready(StatusLine(service_->Snapshot()));
     spdlog::info("reload done");
 }
 
+Status ServiceLoop::OpenAuditTrail() {
+    auto audit = AuditTrail::Open(config_.storage.data_dir);
+    if (!audit) return BadConfig("storage.data_dir: " + audit.error().message);
+    audit_ = std::move(*audit);
+    chain_checked_at_ = UtcTimestampNow();
+    auto chain = store_->VerifyChain();
+    if (!chain) return BadConfig("storage.data_dir: " + chain.error().message);
+    chain_ = *chain;
+    if (chain_.intact) {
+        spdlog::info(
+            "stored records: {} checked against their hash chain, intact{}", chain_.records,
+            chain_.unchained
+                ? " (" + std::to_string(chain_.unchained) + " from before the chain not checked)"
+                : std::string());
+    } else {
+        spdlog::error("stored records: the hash chain is broken: {} (boxd verify --data-dir {})",
+                      chain_.problem, config_.storage.data_dir);
+    }
+    return OkStatus();
+}
+
+std::string ServiceLoop::CalibrationText() const {
+    const CalibrationInForce c = service_->station()->Calibration();
+    return c.calibration ? JsonText(ToJson(*c.calibration)) : "none";
+}
+
+void ServiceLoop::ObserveSettings(const std::string& via) {
+    std::vector<std::pair<std::string, std::string>> settings = {
+        {"software", JsonText(ToJson(software_))}, {"calibration", CalibrationText()}};
+    if (via != "POST /v1/calibrate") {
+        auto root = LoadConfigSections(config_file_);
+        if (!root) {
+            spdlog::error("audit trail: {}", root.error().message);
+            return;
+        }
+        for (const char* section : {"measurement", "scale", "billing"}) {
+            settings.emplace_back(section, SectionText((*root)[section]));
+        }
+    }
+    for (const auto& [what, value] : settings) {
+        if (auto changed = audit_->Observe(what, value, via); !changed) {
+            spdlog::error("audit trail: {}", changed.error().message);
+        }
+    }
+}
+
+std::optional<AuditStatus> ServiceLoop::Audit() const {
+    AuditStatus a;
+    a.event_counter = audit_->Counter();
+    if (auto last = audit_->Events(1); last && !last->empty()) a.last_event = last->front();
+    a.software = software_;
+    a.chain = chain_;
+    a.chain_checked_at = chain_checked_at_;
+    return a;
+}
+
 }  // namespace
 
 Status RunService(ServeConfig config, const std::filesystem::path& config_file,
-                  const ServeOverrides& overrides) {
-    ServiceLoop loop(std::move(config), config_file, overrides);
+                  const ServeOverrides& overrides, const SoftwareIdentity& software) {
+    ServiceLoop loop(std::move(config), config_file, overrides, software);
     return loop.Run();
 }
 

@@ -184,6 +184,15 @@ std::string ServiceMetrics::Text(const MetricsContext& context) const {
         Sample(out, "boxd_calibration_age_seconds", "",
                static_cast<double>(*context.calibration_age_s));
     }
+    if (context.audit) {
+        Header(out, "boxd_metrological_events_total", "counter",
+               "Changes of the software, calibration, measurement, scale or billing settings.");
+        Sample(out, "boxd_metrological_events_total", "",
+               static_cast<double>(context.audit->event_counter));
+        Header(out, "boxd_stored_records_intact", "gauge",
+               "1 when the stored records' hash chain was intact at start.");
+        Sample(out, "boxd_stored_records_intact", "", context.audit->chain.intact ? 1 : 0);
+    }
     if (context.mqtt) {
         const MqttStats& m = *context.mqtt;
         Header(out, "boxd_mqtt_connected", "gauge", "1 while the MQTT broker is connected.");

@@ -10,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "daemon/service/audit_trail.h"
 #include "pipeline/core/error_code.h"
 #include "pipeline/io/measurement.h"
 
@@ -41,7 +42,8 @@ struct MetricsContext {
     std::optional<long long> calibration_age_s;  // nullopt: no calibration, or its age unknown
     bool calibrated = false;
     long long uptime_s = 0;
-    std::optional<MqttStats> mqtt;  // with an mqtt: section
+    std::optional<MqttStats> mqtt;     // with an mqtt: section
+    std::optional<AuditStatus> audit;  // the daemon's audit trail
 };
 
 class ServiceMetrics {

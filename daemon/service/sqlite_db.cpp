@@ -37,6 +37,22 @@ std::string QuickCheck(sqlite3* db) {
     return found.empty() ? "ok" : found;
 }
 
+Result<sqlite3*> OpenDatabaseReadOnly(const std::filesystem::path& data_dir) {
+    const std::filesystem::path path = data_dir / kDatabaseFile;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) {
+        return Error{ErrorCode::kStorageError, path.string() + ": no boxd database there"};
+    }
+    sqlite3* db = nullptr;
+    if (sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
+        Error e = SqlError(db, "cannot open " + path.string());
+        sqlite3_close(db);
+        return e;
+    }
+    sqlite3_busy_timeout(db, 5000);
+    return db;
+}
+
 Result<sqlite3*> OpenDatabase(const std::filesystem::path& data_dir,
                               const std::vector<const char*>& schema) {
     std::error_code ec;

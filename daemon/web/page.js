@@ -69,6 +69,22 @@ function showLive(s) {
     ? `Below: the previous parcel (${shownId}), not the one on the table.` : "");
 }
 
+// The audit trail of GET /v1/status: the event counter, the software, the records' check.
+function showAudit(a) {
+  const facts = $("audit-facts");
+  facts.replaceChildren();
+  if (!a) return;
+  const fact = (name, value) => {
+    facts.append(text(document.createElement("dt"), name), text(document.createElement("dd"), value));
+  };
+  const e = a.last_event;
+  fact("Event counter", e ? `${a.event_counter} (last: ${e.what}, ${localTime(e.at)}, ${e.via})`
+                          : `${a.event_counter}`);
+  fact("Software", `${a.software.version}, commit ${a.software.commit}, SHA-256 ${a.software.sha256.slice(0, 16)}…`);
+  const r = a.records;
+  fact("Stored records", r.intact ? `${r.checked} intact (checked at start)` : `CHANGED: ${r.problem}`);
+}
+
 async function refreshStatus() {
   try {
     const s = await api("/v1/status");
@@ -76,6 +92,7 @@ async function refreshStatus() {
     text($("state-detail"), s.state === "error" && s.last_error
       ? `${s.last_error.code}: ${s.last_error.message}` : "");
     $("measure").disabled = s.state === "measuring" || s.state === "calibrating";
+    showAudit(s.audit);
     showLive(s);
     if (s.last_measurement_id !== latestId) {
       latestId = s.last_measurement_id;

@@ -136,6 +136,7 @@ json ToJson(const MeasurementResult& m) {
     for (const auto& [stage, ms] : m.timing_ms) timing[stage] = Round(ms, 0.1);
     j["timing_ms"] = timing;
     if (m.weight) j["weight"] = ToJson(*m.weight);
+    if (m.software) j["software"] = ToJson(*m.software);
     if (m.billing) j["billing"] = ToJson(*m.billing);
     return j;
 }

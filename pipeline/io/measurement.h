@@ -9,6 +9,7 @@
 
 #include "pipeline/core/result.h"
 #include "pipeline/io/billing_block.h"
+#include "pipeline/io/software_block.h"
 #include "pipeline/io/weight_block.h"
 
 namespace boxd {
@@ -89,6 +90,8 @@ struct MeasurementResult {
     // What the station's scale weighed (a station with a `scale:`); an addition to SPEC
     // section 5.
     std::optional<Weighing> weight;
+    // The program that measured it (the daemon's); an addition to SPEC section 5.
+    std::optional<SoftwareIdentity> software;
 };
 
 const char* StatusName(MeasurementStatus s);

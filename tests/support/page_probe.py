@@ -44,6 +44,7 @@ PROBE = r"""JSON.stringify((() => {
     calibration: $('calibration-facts').textContent, history_text: $('history-table').textContent,
     billing: $('billing').hidden ? null : $('billing').textContent,
     dims: $('dims').textContent,
+    audit: $('audit-facts').textContent,
   };
 })())"""
 

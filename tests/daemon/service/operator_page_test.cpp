@@ -116,6 +116,11 @@ TEST(OperatorPage, FitsPhoneTabletAndDesktopAndShowsWhatIsMeasuredNow) {
     EXPECT_NE(desktop["dims"].get<std::string>().find("Weight" + weight), std::string::npos)
         << desktop["dims"];
     EXPECT_NE(billing.find("weighed" + weight), std::string::npos) << billing;
+    // The metrology card: the event counter, the software, the stored records' check.
+    const std::string audit = desktop["audit"].get<std::string>();
+    EXPECT_NE(audit.find("Event counter0"), std::string::npos) << audit;
+    EXPECT_NE(audit.find("SHA-256 "), std::string::npos) << audit;
+    EXPECT_NE(audit.find("intact (checked at start)"), std::string::npos) << audit;
 
     // While the next parcel is measured: the live panel, the previous result dimmed and named.
     const json& measuring = steps[6];
