@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
     AddDevices(app, run);
     AddBenchMeasure(app, run);
     AddVerify(app, run);
+    AddExport(app, run);
     if (argc < 2) {
         // A bare `boxd`: how to use it, on stderr with the exit code of bad usage.
         std::fprintf(stderr, "%s", app.help().c_str());

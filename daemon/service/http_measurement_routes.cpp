@@ -3,6 +3,7 @@
 
 #include "daemon/service/http_response.h"
 #include "daemon/service/http_routes.h"
+#include "daemon/service/measurement_csv.h"
 
 namespace boxd {
 
@@ -138,6 +139,27 @@ void GetCloud(const ApiContext& api, const Request& req, Response& res) {
     res.set_content(std::move(data), "application/octet-stream");
 }
 
+// GET /v1/measurements.csv[?since=T]: every stored measurement finished since T, oldest first.
+void ExportCsv(const ApiContext& api, const Request& req, Response& res) {
+    std::string since;
+    if (req.has_param("since")) {
+        auto checked = CheckSince(req.get_param_value("since"));
+        if (!checked) {
+            SetError(res, ErrorCode::kBadRequest, checked.error().message);
+            return;
+        }
+        since = *checked;
+    }
+    auto records = api.store.ListSince(since);
+    if (!records) {
+        SetError(res, records.error());
+        return;
+    }
+    res.status = 200;
+    res.set_header("Content-Disposition", "attachment; filename=\"boxd-measurements.csv\"");
+    res.set_content(MeasurementsCsv(*records), "text/csv; charset=utf-8; header=present");
+}
+
 }  // namespace
 
 void AddMeasurementRoutes(RouteTable& routes, const ApiContext& api) {
@@ -146,6 +168,8 @@ void AddMeasurementRoutes(RouteTable& routes, const ApiContext& api) {
     routes.Get("/v1/measurements", Guarded([api](const Request& req, Response& res) {
                    ListMeasurements(api, req, res);
                }));
+    routes.Get(R"(/v1/measurements\.csv)",
+               Guarded([api](const Request& req, Response& res) { ExportCsv(api, req, res); }));
     routes.Get(R"(/v1/measurements/([^/]+))", Guarded([api](const Request& req, Response& res) {
                    GetMeasurement(api, req, res);
                }));

@@ -28,8 +28,8 @@ struct ApiContext {
 
 // GET /v1/health, GET /v1/status, GET /v1/audit, GET /v1/openapi.json, GET /metrics.
 void AddStatusRoutes(RouteTable& routes, const ApiContext& api);
-// POST /v1/measure, GET /v1/measurements, /v1/measurements/{id} (and "last"),
-// /v1/measurements/{id}/cloud.ply.
+// POST /v1/measure, GET /v1/measurements, /v1/measurements.csv, /v1/measurements/{id} (and
+// "last"), /v1/measurements/{id}/cloud.ply.
 void AddMeasurementRoutes(RouteTable& routes, const ApiContext& api);
 // POST /v1/calibrate, GET /v1/calibration.
 void AddCalibrationRoutes(RouteTable& routes, const ApiContext& api);

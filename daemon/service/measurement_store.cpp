@@ -308,6 +308,28 @@ Result<std::vector<json>> MeasurementStore::List(int limit,
     return out;
 }
 
+Result<std::vector<json>> ReadMeasurementsSince(sqlite3* db, const std::string& since) {
+    SqlStatement q(db,
+                   "SELECT id, result_json FROM measurements WHERE finished_at >= ?"
+                   " ORDER BY seq;");
+    if (!q.prepared()) return SqlError(db, "cannot prepare a query");
+    q.Bind(1, since);
+    std::vector<json> out;
+    int rc;
+    while ((rc = q.Step()) == SQLITE_ROW) {
+        auto j = ParseStored(q.Text(1), q.Text(0));
+        if (!j) return j.error();
+        out.push_back(std::move(**j));
+    }
+    if (rc != SQLITE_DONE) return SqlError(db, "cannot list measurements");
+    return out;
+}
+
+Result<std::vector<json>> MeasurementStore::ListSince(const std::string& since) {
+    std::lock_guard lock(mutex_);
+    return ReadMeasurementsSince(db_, since);
+}
+
 Result<std::optional<fs::path>> MeasurementStore::CloudPath(const std::string& id) {
     if (!IsValidId(id)) return std::optional<fs::path>();
     std::lock_guard lock(mutex_);

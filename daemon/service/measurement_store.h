@@ -28,6 +28,9 @@ struct MeasurementFiles {
     std::optional<std::filesystem::path> session_dir;
 };
 
+// ListSince on a database opened elsewhere (`boxd export`, read-only).
+Result<std::vector<nlohmann::json>> ReadMeasurementsSince(sqlite3* db, const std::string& since);
+
 class MeasurementStore {
 public:
     // Returns the store in `data_dir` (created when missing), keeping at most `retention`
@@ -60,6 +63,9 @@ public:
     // Returns up to `limit` measurements, newest first; with `parcel_id`, only that parcel's.
     Result<std::vector<nlohmann::json>> List(int limit,
                                              const std::optional<std::string>& parcel_id = {});
+    // Returns every measurement finished at or after `since` (CheckSince's form; "" for all),
+    // oldest first.
+    Result<std::vector<nlohmann::json>> ListSince(const std::string& since);
     // Returns the path of the fused cloud of `id`, or nullopt when `id` or its cloud is missing.
     Result<std::optional<std::filesystem::path>> CloudPath(const std::string& id);
     // Returns the number of stored measurements.
