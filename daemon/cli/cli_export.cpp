@@ -1,7 +1,5 @@
 // `boxd export --data-dir DIR [--since T]`: the stored measurements as CSV on stdout, as GET
 // /v1/measurements.csv gives them — read-only, beside a running daemon too.
-#include <sqlite3.h>
-
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <memory>
@@ -20,10 +18,6 @@ struct ExportOptions {
     std::string since;
 };
 
-struct DbCloser {
-    void operator()(sqlite3* db) const { sqlite3_close(db); }
-};
-
 int RunExport(const ExportOptions& o) {
     std::string since;
     if (!o.since.empty()) {
@@ -35,7 +29,7 @@ int RunExport(const ExportOptions& o) {
     if (!opened) {
         return Fail(Error{ErrorCode::kInvalidInput, "--data-dir: " + opened.error().message});
     }
-    std::unique_ptr<sqlite3, DbCloser> db(*opened);
+    const DatabaseHandle db = std::move(*opened);
     auto records = ReadMeasurementsSince(db.get(), since);
     if (!records) return Fail(records.error());
     const std::string csv = MeasurementsCsv(*records);

@@ -1,7 +1,5 @@
 // `boxd verify --data-dir DIR`: checks a data folder's stored records against their hash chain
 // and lists the metrological events — without changing anything, beside a running daemon too.
-#include <sqlite3.h>
-
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <memory>
@@ -24,16 +22,12 @@ struct VerifyOptions {
     int events = 20;
 };
 
-struct DbCloser {
-    void operator()(sqlite3* db) const { sqlite3_close(db); }
-};
-
 int RunVerify(const VerifyOptions& o) {
     auto opened = OpenDatabaseReadOnly(o.data_dir);
     if (!opened) {
         return Fail(Error{ErrorCode::kInvalidInput, "--data-dir: " + opened.error().message});
     }
-    std::unique_ptr<sqlite3, DbCloser> db(*opened);
+    const DatabaseHandle db = std::move(*opened);
     auto chain = VerifyRecordChain(db.get());
     if (!chain) return Fail(chain.error());
     auto events = ReadAuditEvents(db.get(), o.events);

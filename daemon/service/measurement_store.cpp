@@ -70,6 +70,19 @@ Result<std::optional<json>> ParseStored(const std::string& text, const std::stri
     return std::optional<json>(std::move(j));
 }
 
+// The stored measurements (id, result_json) the query `q` on `db` gives, in its order.
+Result<std::vector<json>> StoredRows(sqlite3* db, SqlStatement& q) {
+    std::vector<json> out;
+    int rc;
+    while ((rc = q.Step()) == SQLITE_ROW) {
+        auto j = ParseStored(q.Text(1), q.Text(0));
+        if (!j) return j.error();
+        out.push_back(std::move(**j));
+    }
+    if (rc != SQLITE_DONE) return SqlError(db, "cannot list measurements");
+    return out;
+}
+
 // A record retention removes, and its files.
 struct Doomed {
     std::string id, cloud_file, session_dir, hash;
@@ -297,15 +310,7 @@ Result<std::vector<json>> MeasurementStore::List(int limit,
     int param = 1;
     if (parcel_id) q.Bind(param++, *parcel_id);
     q.Bind(param, static_cast<long long>(limit));
-    std::vector<json> out;
-    int rc;
-    while ((rc = q.Step()) == SQLITE_ROW) {
-        auto j = ParseStored(q.Text(1), q.Text(0));
-        if (!j) return j.error();
-        out.push_back(std::move(**j));
-    }
-    if (rc != SQLITE_DONE) return SqlError(db_, "cannot list measurements");
-    return out;
+    return StoredRows(db_, q);
 }
 
 Result<std::vector<json>> ReadMeasurementsSince(sqlite3* db, const std::string& since) {
@@ -314,15 +319,7 @@ Result<std::vector<json>> ReadMeasurementsSince(sqlite3* db, const std::string& 
                    " ORDER BY seq;");
     if (!q.prepared()) return SqlError(db, "cannot prepare a query");
     q.Bind(1, since);
-    std::vector<json> out;
-    int rc;
-    while ((rc = q.Step()) == SQLITE_ROW) {
-        auto j = ParseStored(q.Text(1), q.Text(0));
-        if (!j) return j.error();
-        out.push_back(std::move(**j));
-    }
-    if (rc != SQLITE_DONE) return SqlError(db, "cannot list measurements");
-    return out;
+    return StoredRows(db, q);
 }
 
 Result<std::vector<json>> MeasurementStore::ListSince(const std::string& since) {

@@ -37,7 +37,7 @@ std::string QuickCheck(sqlite3* db) {
     return found.empty() ? "ok" : found;
 }
 
-Result<sqlite3*> OpenDatabaseReadOnly(const std::filesystem::path& data_dir) {
+Result<DatabaseHandle> OpenDatabaseReadOnly(const std::filesystem::path& data_dir) {
     const std::filesystem::path path = data_dir / kDatabaseFile;
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec)) {
@@ -50,7 +50,7 @@ Result<sqlite3*> OpenDatabaseReadOnly(const std::filesystem::path& data_dir) {
         return e;
     }
     sqlite3_busy_timeout(db, 5000);
-    return db;
+    return DatabaseHandle(db);
 }
 
 Result<sqlite3*> OpenDatabase(const std::filesystem::path& data_dir,

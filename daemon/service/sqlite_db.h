@@ -5,6 +5,7 @@
 #include <sqlite3.h>
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -25,9 +26,14 @@ Status SqlExec(sqlite3* db, const char* sql);
 Result<sqlite3*> OpenDatabase(const std::filesystem::path& data_dir,
                               const std::vector<const char*>& schema);
 
+struct DatabaseCloser {
+    void operator()(sqlite3* db) const { sqlite3_close(db); }
+};
+using DatabaseHandle = std::unique_ptr<sqlite3, DatabaseCloser>;
+
 // Opens DATA_DIR/boxd.db to read only (a check beside a running daemon changes nothing);
 // STORAGE_ERROR when there is none or it cannot be read.
-Result<sqlite3*> OpenDatabaseReadOnly(const std::filesystem::path& data_dir);
+Result<DatabaseHandle> OpenDatabaseReadOnly(const std::filesystem::path& data_dir);
 
 // Returns "ok", or what SQLite's PRAGMA quick_check finds wrong with `db` (its first findings,
 // one per line): a damaged page is said at start rather than met by a later query.
