@@ -211,6 +211,26 @@ Result<std::optional<Weighing>> DeviceStation::Weigh(const JobContext& ctx) {
     return std::optional<Weighing>(std::move(*weighed));
 }
 
+Result<std::string> DeviceStation::ScaleCommand(const std::string& command) {
+    if (!config_.station.scale.enabled()) {
+        return Error{ErrorCode::kNotFound, "the station has no scale"};
+    }
+    // Between runs only: a weighing holds the same lock.
+    std::lock_guard life(lifecycle_mutex_);
+    std::shared_ptr<StationDevices> devices;
+    {
+        std::lock_guard lock(devices_mutex_);
+        devices = devices_;
+    }
+    if (!devices || !open_ || !devices->scale) {
+        return Error{ErrorCode::kScaleError, "the devices are not open"};
+    }
+    Status sent = command == "tare" ? devices->scale->Tare() : devices->scale->Zero();
+    if (!sent) return sent.error();
+    spdlog::info("scale: {} command sent", command);
+    return devices->scale->Describe();
+}
+
 JobOutput DeviceStation::Measure(const JobContext& ctx) {
     // The parcel is weighed at rest, before the table turns (a turning table shakes the
     // platform); a scale that cannot weigh ends the run before it starts.

@@ -53,6 +53,7 @@ public:
     void Shutdown() override;
     DeviceHealth Devices() const override;
     CalibrationInForce Calibration() const override;
+    Result<std::string> ScaleCommand(const std::string& command) override;
 
 private:
     // Opens the devices and homes the table; the caller holds lifecycle_mutex_.

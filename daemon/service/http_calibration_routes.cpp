@@ -1,5 +1,5 @@
-// The calibration routes: run the station calibration with a reference box, and the calibration
-// in force with its history.
+// The calibration routes: run the station calibration with a reference box, the calibration
+// in force with its history, and the scale's zero and tare.
 #include <spdlog/spdlog.h>
 
 #include "daemon/service/http_response.h"
@@ -65,6 +65,22 @@ void AddCalibrationRoutes(RouteTable& routes, const ApiContext& api) {
                    }
                    SetJson(res, 200, j);
                }));
+
+    // The scale's own commands, between runs: zero with the platform empty, tare with a
+    // container on it.
+    const auto scale_command = [api](const char* command) {
+        return Guarded([api, command](const Request& req, Response& res) {
+            if (!JsonObjectBody(req, res, false, {})) return;
+            Result<std::string> sent = api.service.ScaleCommand(command);
+            if (!sent) {
+                SetError(res, sent.error());
+                return;
+            }
+            SetJson(res, 200, json{{"command", command}, {"scale", *sent}});
+        });
+    };
+    routes.Post("/v1/scale/zero", scale_command("zero"));
+    routes.Post("/v1/scale/tare", scale_command("tare"));
 }
 
 }  // namespace boxd

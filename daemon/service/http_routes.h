@@ -31,7 +31,7 @@ void AddStatusRoutes(RouteTable& routes, const ApiContext& api);
 // POST /v1/measure, GET /v1/measurements, /v1/measurements.csv, /v1/measurements/{id} (and
 // "last"), /v1/measurements/{id}/cloud.ply.
 void AddMeasurementRoutes(RouteTable& routes, const ApiContext& api);
-// POST /v1/calibrate, GET /v1/calibration.
+// POST /v1/calibrate, GET /v1/calibration, POST /v1/scale/zero, POST /v1/scale/tare.
 void AddCalibrationRoutes(RouteTable& routes, const ApiContext& api);
 // GET / (the operator page) and GET /three.min.js.
 void AddPageRoutes(RouteTable& routes, const ApiContext& api);

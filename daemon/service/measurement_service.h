@@ -69,6 +69,10 @@ public:
     Result<CalibrationRun> Calibrate(const BoxDimensions& reference,
                                      std::chrono::milliseconds timeout);
 
+    // Sends the station's scale `command` ("zero" or "tare") and returns its description; BUSY
+    // while a measurement or calibration runs, or the station's error.
+    Result<std::string> ScaleCommand(const std::string& command);
+
     // Returns up to `limit` finished calibrations, newest first, as CalibrationHistory::List
     // reads them from storage, or STORAGE_ERROR when the history is not available.
     Result<std::vector<nlohmann::json>> ListCalibrations(int limit);

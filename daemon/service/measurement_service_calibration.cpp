@@ -1,5 +1,6 @@
 // MeasurementService's calibration runs (POST /v1/calibrate): one at a time on the worker, like
-// measurements, each finished one (report or refusal) kept in the calibration history.
+// measurements, each finished one (report or refusal) kept in the calibration history; and the
+// scale's zero and tare between runs.
 #include <spdlog/spdlog.h>
 
 #include <exception>
@@ -14,6 +15,11 @@ Result<std::vector<json>> MeasurementService::ListCalibrations(int limit) {
     if (!history_)
         return Error{ErrorCode::kStorageError, "the calibration history is not available"};
     return history_->List(limit);
+}
+
+Result<std::string> MeasurementService::ScaleCommand(const std::string& command) {
+    if (Busy()) return Error{ErrorCode::kBusy, "a measurement or calibration is running"};
+    return station()->ScaleCommand(command);
 }
 
 struct MeasurementService::CalibrationJob {

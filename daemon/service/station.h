@@ -104,6 +104,12 @@ public:
     virtual DeviceHealth Devices() const = 0;
     // Returns the calibration in force for GET /v1/calibration.
     virtual CalibrationInForce Calibration() const = 0;
+    // Sends the scale's "zero" or "tare" command (POST /v1/scale/zero|tare) and returns the
+    // scale's description; NOT_FOUND for a station without a scale, SCALE_ERROR when it fails.
+    virtual Result<std::string> ScaleCommand(const std::string& command) {
+        (void)command;
+        return Error{ErrorCode::kNotFound, "the station has no scale"};
+    }
 };
 
 }  // namespace boxd

@@ -93,6 +93,8 @@ async function refreshStatus() {
       ? `${s.last_error.code}: ${s.last_error.message}` : "");
     $("measure").disabled = s.state === "measuring" || s.state === "calibrating";
     showAudit(s.audit);
+    $("zero-scale").hidden = !s.devices.scale;
+    $("zero-scale").disabled = s.state === "measuring" || s.state === "calibrating";
     showLive(s);
     if (s.last_measurement_id !== latestId) {
       latestId = s.last_measurement_id;
@@ -227,6 +229,12 @@ $("measure").addEventListener("click", async () => {
     if (openedId) location.hash = "";  // back to the latest: the new result will be shown
   } catch (e) { say(`${e.code}: ${e.message}`, true); }
   refreshStatus();
+});
+$("zero-scale").addEventListener("click", async () => {
+  try {
+    const r = await api("/v1/scale/zero", { method: "POST" });
+    say(`scale zeroed (${r.scale})`);
+  } catch (e) { say(`${e.code}: ${e.message}`, true); }
 });
 $("parcel").addEventListener("keydown", (e) => { if (e.key === "Enter") $("measure").click(); });
 $("back-to-latest").addEventListener("click", () => { location.hash = ""; });

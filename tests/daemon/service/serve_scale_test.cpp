@@ -130,5 +130,59 @@ TEST(ServeScale, EachScaleFaultIsAStoredScaleErrorAndTheTableNeverTurns) {
     }
 }
 
+TEST(ServeScale, ZeroAndTareAreSentBetweenRuns) {
+    test::TempDir dir;
+    test::ServeDaemon daemon(SimConfigWith(dir.path(), 3.5, "none"), dir.path() / "data",
+                             dir.path() / "boxd.log");
+    ASSERT_TRUE(daemon.WaitHealthy()) << test::ReadText(dir.path() / "boxd.log");
+    const auto measure = [&daemon] {
+        auto res = daemon.client().Post("/v1/measure?wait=1", "", "application/json");
+        return res && res->status == 200 ? json::parse(res->body) : json();
+    };
+    // A tare leaves the gross weight (what the station reads) as it was.
+    auto tared = daemon.client().Post("/v1/scale/tare", "", "application/json");
+    ASSERT_TRUE(tared);
+    ASSERT_EQ(tared->status, 200) << tared->body;
+    EXPECT_EQ(json::parse(tared->body)["command"], "tare");
+    EXPECT_DOUBLE_EQ(measure()["weight"]["value"].get<double>(), 3.5);
+    // Zeroed with the parcel on it, the scale then reads about nothing: below Min, no weight
+    // is stated and none is billed.
+    auto zeroed = daemon.client().Post("/v1/scale/zero", "", "application/json");
+    ASSERT_TRUE(zeroed);
+    ASSERT_EQ(zeroed->status, 200) << zeroed->body;
+    const json j = measure();
+    ASSERT_EQ(j["status"], "ok") << j.dump();
+    EXPECT_TRUE(j["weight"]["value"].is_null()) << j["weight"].dump();
+    EXPECT_NE(j["weight"]["why_not"].get<std::string>().find("below the scale's minimum load"),
+              std::string::npos);
+    EXPECT_TRUE(j["billing"]["actual_weight"].is_null());
+    EXPECT_TRUE(j["billing"]["carriers"][0]["billable_weight"].is_null());
+    // A body is not a command's.
+    auto odd = daemon.client().Post("/v1/scale/zero", R"({"now": true})", "application/json");
+    ASSERT_TRUE(odd);
+    EXPECT_EQ(odd->status, 400);
+}
+
+TEST(ServeScale, AStationWithoutAScaleSaysSo) {
+    test::TempDir dir;
+    YAML::Node root = YAML::LoadFile(test::SimConfigPath().string());
+    root.remove("scale");
+    YAML::Emitter out;
+    out << root;
+    std::ofstream(dir.path() / "noscale.yaml") << out.c_str() << "\n";
+    test::ServeDaemon daemon(dir.path() / "noscale.yaml", dir.path() / "data",
+                             dir.path() / "boxd.log");
+    ASSERT_TRUE(daemon.WaitHealthy()) << test::ReadText(dir.path() / "boxd.log");
+    EXPECT_TRUE(daemon.GetJson("/v1/status")["devices"]["scale"].is_null());
+    auto res = daemon.client().Post("/v1/scale/zero", "", "application/json");
+    ASSERT_TRUE(res);
+    EXPECT_EQ(res->status, 404) << res->body;
+    auto measured = daemon.client().Post("/v1/measure?wait=1", "", "application/json");
+    ASSERT_TRUE(measured);
+    const json j = json::parse(measured->body);
+    EXPECT_FALSE(j.contains("weight"));
+    EXPECT_TRUE(j["billing"]["actual_weight"].is_null());
+}
+
 }  // namespace
 }  // namespace boxd
