@@ -29,6 +29,7 @@ public:
         client.driver = "modbus-tcp";
         client.host = "127.0.0.1";
         client.port = scale->simulator_.port();
+        client.registers = ScaleProfile{};  // the map the simulated indicator serves
         auto driver = ModbusScale::Open(client);
         if (!driver) return driver.error();
         scale->driver_ = std::move(*driver);

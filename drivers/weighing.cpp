@@ -100,6 +100,18 @@ Weighing Settled(const Window& w, const Scale& scale, const ScaleConfig& c, doub
     return out;
 }
 
+// Why `r` is outside the scale's range, or "".
+std::string OutOfRange(const ScaleReading& r, const ScaleConfig& c) {
+    if (r.overload || r.weight > c.capacity + 9 * c.division) {
+        return "overload: the load is above the scale's capacity of " + Amount(c.capacity, c.unit) +
+               " (nothing may lean on the platform)";
+    }
+    if (r.underload) {
+        return "underload: the scale reads below zero (empty the platform and zero the scale)";
+    }
+    return "";
+}
+
 }  // namespace
 
 WeighingClock RealWeighingClock() {
@@ -118,22 +130,27 @@ Result<Weighing> WeighStable(Scale& scale, const ScaleConfig& c, const std::atom
     const double t0 = clock.now_ms();
     Window window;
     int readings = 0;
+    bool out_of_range = false;
+    double out_of_range_since = 0.0;
     for (;;) {
         if (cancel && cancel->load()) return Error{ErrorCode::kAborted, "weighing cancelled"};
         Result<ScaleReading> r = scale.Read();
         if (!r) return r.error();
         ++readings;
         const double now = clock.now_ms();
-        if (r->overload || r->weight > c.capacity + 9 * c.division) {
-            return ScaleFault(scale, "overload: the load is above the scale's capacity of " +
-                                         Amount(c.capacity, c.unit) +
-                                         " (nothing may lean on the platform)");
+        // Out of range for a whole stable time is the answer; a moment of it (a parcel's
+        // overshoot as it is set down) is motion.
+        if (const std::string why = OutOfRange(*r, c); !why.empty()) {
+            if (!out_of_range) out_of_range_since = now;
+            out_of_range = true;
+            if (now - out_of_range_since >= c.stable_time_ms || now - t0 >= c.timeout_ms) {
+                return ScaleFault(scale, why);
+            }
+            window.clear();
+            clock.sleep_ms(c.poll_interval_ms);
+            continue;
         }
-        if (r->underload) {
-            return ScaleFault(scale,
-                              "underload: the scale reads below zero (empty the platform and zero "
-                              "the scale)");
-        }
+        out_of_range = false;
         window.push_back({now, r->weight, r->stable});
         // The oldest reading kept is the newest one at least the stable time old.
         while (window.size() > 1 && window[1].t_ms <= now - c.stable_time_ms) window.pop_front();

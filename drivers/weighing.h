@@ -3,10 +3,11 @@
 // weighing instruments use for a stable equilibrium (OIML R76 4.4.2, NIST HB44 2.20 S.2.4):
 // every reading of the last `stable_time_ms` lies within `stable_band_divisions` of each
 // other — and, with use_stable_flag, the indicator itself says "no motion". The weight is the
-// mean of those readings rounded to the division. Overload and underload end the weighing at
-// once; no stable weight within `timeout_ms` is a SCALE_ERROR that says whether the readings
-// moved steadily one way (a drifting zero: re-zero the empty scale) or to and fro (something
-// touches the platform, or it shakes). A load below Min is weighed but not stated.
+// mean of those readings rounded to the division. An overload or underload that lasts a whole
+// stable time ends the weighing (a moment of it, a parcel's overshoot, is motion); no stable weight
+// within `timeout_ms` is a SCALE_ERROR that says whether the readings moved steadily one way (a
+// drifting zero: re-zero the empty scale) or to and fro (something touches the platform, or it
+// shakes). A load below Min is weighed but not stated.
 
 #include <atomic>
 #include <functional>

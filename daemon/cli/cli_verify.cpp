@@ -32,6 +32,8 @@ int RunVerify(const VerifyOptions& o) {
     if (!chain) return Fail(chain.error());
     auto events = ReadAuditEvents(db.get(), o.events);
     if (!events) return Fail(events.error());
+    auto counter = ReadEventCounter(db.get());
+    if (!counter) return Fail(counter.error());
     json list = json::array();
     for (const AuditEvent& e : *events) list.push_back(ToJson(e));
     const json out = {
@@ -41,7 +43,7 @@ int RunVerify(const VerifyOptions& o) {
           {"unchained", chain->unchained},
           {"head", chain->head},
           {"problem", chain->problem.empty() ? json(nullptr) : json(chain->problem)}}},
-        {"event_counter", events->empty() ? 0 : events->front().counter},
+        {"event_counter", *counter},
         {"events", list}};
     std::printf("%s\n", JsonText(out).c_str());
     if (!chain->intact) {

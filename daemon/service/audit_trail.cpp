@@ -72,16 +72,26 @@ Result<std::unique_ptr<AuditTrail>> AuditTrail::Open(const std::filesystem::path
     if (!db) return db.error();
     std::unique_ptr<AuditTrail> trail(new AuditTrail(*db));
     std::lock_guard lock(trail->mutex_);
-    auto counter = trail->ReadCounterLocked();
+    auto counter = ReadEventCounter(trail->db_);
     if (!counter) return counter.error();
     trail->counter_ = *counter;
     return trail;
 }
 
-Result<long long> AuditTrail::ReadCounterLocked() {
-    SqlStatement q(db_, "SELECT coalesce(max(counter), 0) FROM audit_events;");
+namespace {
+
+bool HasTrail(sqlite3* db) {
+    SqlStatement t(db, "SELECT 1 FROM sqlite_master WHERE name = 'audit_events';");
+    return t.prepared() && t.Step() == SQLITE_ROW;
+}
+
+}  // namespace
+
+Result<long long> ReadEventCounter(sqlite3* db) {
+    if (!HasTrail(db)) return 0LL;
+    SqlStatement q(db, "SELECT coalesce(max(counter), 0) FROM audit_events;");
     if (!q.prepared() || q.Step() != SQLITE_ROW) {
-        return SqlError(db_, "cannot read the event counter");
+        return SqlError(db, "cannot read the event counter");
     }
     return q.Int(0);
 }
@@ -109,7 +119,7 @@ Result<bool> AuditTrail::Observe(const std::string& what, const std::string& val
     if (!set.prepared() || set.Step() != SQLITE_DONE) return fail("cannot record " + what);
     AuditEvent e{0, UtcTimestampNow(), what, before.value_or(""), value, via};
     if (before) {
-        auto counter = ReadCounterLocked();
+        auto counter = ReadEventCounter(db_);
         if (!counter) return fail("cannot read the event counter");
         e.counter = *counter + 1;
         SqlStatement add(db_, "INSERT INTO audit_events VALUES (?, ?, ?, ?, ?, ?);");
@@ -121,7 +131,7 @@ Result<bool> AuditTrail::Observe(const std::string& what, const std::string& val
         add.Bind(6, e.via);
         if (!add.prepared() || add.Step() != SQLITE_DONE) return fail("cannot record the event");
     }
-    if (auto s = SqlExec(db_, "COMMIT;"); !s) return s.error();
+    if (auto s = SqlExec(db_, "COMMIT;"); !s) return fail("cannot commit the event");
     if (!before) return false;
     counter_ = e.counter;
     spdlog::warn("metrological event {}: {} changed through {}: {} -> {}", e.counter, what, via,
@@ -141,11 +151,7 @@ Result<std::vector<AuditEvent>> AuditTrail::Events(int limit) {
 
 Result<std::vector<AuditEvent>> ReadAuditEvents(sqlite3* db, int limit) {
     std::vector<AuditEvent> out;
-    {
-        SqlStatement t(db, "SELECT 1 FROM sqlite_master WHERE name = 'audit_events';");
-        if (!t.prepared()) return SqlError(db, "cannot read the database's tables");
-        if (t.Step() != SQLITE_ROW) return out;
-    }
+    if (!HasTrail(db)) return out;
     SqlStatement q(db,
                    "SELECT counter, at, what, from_value, to_value, via FROM audit_events"
                    " ORDER BY counter DESC LIMIT ?;");

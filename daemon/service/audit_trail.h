@@ -60,6 +60,8 @@ std::string SectionText(const YAML::Node& section);
 // Returns up to `limit` events of the trail in `db`, newest first (none in a database without a
 // trail).
 Result<std::vector<AuditEvent>> ReadAuditEvents(sqlite3* db, int limit);
+// Returns the event counter of the trail in `db` (0 without a trail).
+Result<long long> ReadEventCounter(sqlite3* db);
 
 class AuditTrail {
 public:
@@ -79,7 +81,6 @@ public:
 
 private:
     explicit AuditTrail(sqlite3* db);
-    Result<long long> ReadCounterLocked();
 
     sqlite3* db_;
     std::mutex mutex_;

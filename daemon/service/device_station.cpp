@@ -215,8 +215,11 @@ Result<std::string> DeviceStation::ScaleCommand(const std::string& command) {
     if (!config_.station.scale.enabled()) {
         return Error{ErrorCode::kNotFound, "the station has no scale"};
     }
-    // Between runs only: a weighing holds the same lock.
-    std::lock_guard life(lifecycle_mutex_);
+    // Between runs only: a weighing, a capture or an open holds the same lock.
+    std::unique_lock life(lifecycle_mutex_, std::try_to_lock);
+    if (!life.owns_lock()) {
+        return Error{ErrorCode::kBusy, "the station is busy (a run or the devices' start)"};
+    }
     std::shared_ptr<StationDevices> devices;
     {
         std::lock_guard lock(devices_mutex_);
@@ -323,8 +326,10 @@ DeviceHealth DeviceStation::Devices() const {
     const bool open = open_.load();
     // A device is ok while the station is open, and also while the other device's fault has
     // closed both: it did not fail itself (it was up, and is re-opened with the other).
+    // (The scale's open failing closes the turntable and the camera as well.)
     const auto closed_by = [&](ErrorCode other, const std::string& description) {
-        return device_error_ && device_error_->code == other && !description.empty();
+        return device_error_ && !description.empty() &&
+               (device_error_->code == other || device_error_->code == ErrorCode::kScaleError);
     };
     return DeviceHealth{
         DeviceState{config_.station.turntable.driver, turntable_description_,

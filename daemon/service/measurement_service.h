@@ -97,6 +97,11 @@ public:
     // The program's identification, put in every finished measurement. Set before the first
     // measurement starts.
     void set_software(SoftwareIdentity software) { software_ = std::move(software); }
+    // Called (from the calibration's thread) when a calibration has put a new one in force. Set
+    // before the first calibration starts.
+    void set_on_calibrated(std::function<void()> on_calibrated) {
+        on_calibrated_ = std::move(on_calibrated);
+    }
     // Called (from any thread) whenever the state or the progress changes.
     void set_on_change(std::function<void()> on_change);
     // Called (from the measurement's thread) with every finished measurement, once it is
@@ -151,6 +156,7 @@ private:
     std::function<void()> on_change_;
     std::function<void(const MeasurementResult&)> on_finished_;
     std::optional<SoftwareIdentity> software_;
+    std::function<void()> on_calibrated_;
     std::unique_ptr<CalibrationHistory> history_;
     ServiceMetrics metrics_;  // null when it could not be opened
 };

@@ -86,6 +86,7 @@ void MeasurementService::RunCalibration(std::shared_ptr<CalibrationJob> job,
     }
     if (result) {
         spdlog::info("calibration done: the new calibration is in force");
+        if (on_calibrated_) on_calibrated_();
     } else {
         spdlog::error("calibration failed: {}: {}", ErrorCodeName(result.error().code),
                       result.error().message);

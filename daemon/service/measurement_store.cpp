@@ -127,10 +127,12 @@ Status PruneRows(sqlite3* db, int retention, std::vector<Doomed>& doomed) {
                        " ORDER BY seq DESC LIMIT -1 OFFSET ?;");
         if (!q.prepared()) return SqlError(db, "cannot prepare the retention query");
         q.Bind(1, static_cast<long long>(retention));
-        while (q.Step() == SQLITE_ROW) {
+        int rc;
+        while ((rc = q.Step()) == SQLITE_ROW) {
             if (doomed.empty()) newest_seq = q.Int(4);
             doomed.push_back({q.Text(0), q.Text(1), q.Text(2), q.Text(3)});
         }
+        if (rc != SQLITE_DONE) return SqlError(db, "cannot list what retention removes");
     }
     if (doomed.empty()) return OkStatus();
     if (!doomed.front().hash.empty()) {
@@ -275,6 +277,11 @@ Status MeasurementStore::Save(const MeasurementResult& result, const Measurement
 Result<ChainReport> MeasurementStore::VerifyChain() {
     std::lock_guard lock(mutex_);
     return VerifyRecordChain(db_);
+}
+
+Result<std::string> MeasurementStore::ChainHeadHash() {
+    std::lock_guard lock(mutex_);
+    return ChainHead(db_);
 }
 
 Result<std::optional<json>> MeasurementStore::Last() {

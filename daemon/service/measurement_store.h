@@ -72,6 +72,8 @@ public:
     Result<int> Count();
     // Checks the stored records against their hash chain (daemon/service/record_chain.h).
     Result<ChainReport> VerifyChain();
+    // Returns the chain's head: the newest record's hash.
+    Result<std::string> ChainHeadHash();
 
 private:
     MeasurementStore(std::filesystem::path data_dir, sqlite3* db, int retention);

@@ -70,18 +70,31 @@ Status SetChainPruned(sqlite3* db, const std::string& hash, long long seq) {
     return OkStatus();
 }
 
-Result<ChainReport> VerifyRecordChain(sqlite3* db) {
+namespace {
+
+// A data folder from before the chain: its records are counted, unchecked — unless some row
+// has a hash, when the chain's state row was removed.
+ChainReport WithoutChainState(sqlite3* db) {
+    ChainReport r;
+    r.head = kChainGenesis;
+    SqlStatement n(db, "SELECT count(*) FROM measurements;");
+    if (n.prepared() && n.Step() == SQLITE_ROW) r.unchained = n.Int(0);
+    if (HasColumn(db, "hash")) {
+        SqlStatement h(db, "SELECT count(*) FROM measurements WHERE hash IS NOT NULL;");
+        if (h.prepared() && h.Step() == SQLITE_ROW && h.Int(0) > 0) {
+            r.intact = false;
+            r.problem = "the chain's state was removed from the database";
+        }
+    }
+    return r;
+}
+
+Result<ChainReport> VerifyInSnapshot(sqlite3* db) {
     ChainReport r;
     {
-        // A data folder from before the chain: its records are there, unchecked.
         SqlStatement t(db, "SELECT 1 FROM sqlite_master WHERE name = 'record_chain';");
         if (!t.prepared()) return SqlError(db, "cannot read the database's tables");
-        if (t.Step() != SQLITE_ROW) {
-            SqlStatement n(db, "SELECT count(*) FROM measurements;");
-            if (n.prepared() && n.Step() == SQLITE_ROW) r.unchained = n.Int(0);
-            r.head = kChainGenesis;
-            return r;
-        }
+        if (t.Step() != SQLITE_ROW) return WithoutChainState(db);
     }
     long long head_seq = 0, pruned_seq = 0;
     std::string expected = kChainGenesis;
@@ -136,6 +149,16 @@ Result<ChainReport> VerifyRecordChain(sqlite3* db) {
                      "deleted"
                    : "the chain's head is not " + last_id + ": newer records were deleted");
     }
+    return r;
+}
+
+}  // namespace
+
+Result<ChainReport> VerifyRecordChain(sqlite3* db) {
+    // One read transaction: a daemon storing or pruning meanwhile is not seen half-way.
+    if (Status s = SqlExec(db, "BEGIN;"); !s) return s.error();
+    Result<ChainReport> r = VerifyInSnapshot(db);
+    (void)SqlExec(db, "COMMIT;");
     return r;
 }
 

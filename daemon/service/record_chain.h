@@ -7,7 +7,7 @@
 // deleted with a database tool breaks a link, the head, or the link to what retention removed:
 // VerifyRecordChain finds it and names the record. It is a check against changes by hand, not a
 // signature: someone who recomputes every later hash and the head as well is not detected —
-// the head published in /v1/status and with each MQTT result is what a fleet can hold it to.
+// the head /v1/status publishes (audit.records.head) is what a fleet can hold it to.
 // Records stored before the chain existed (an older data folder) are counted, not checked.
 
 #include <string>

@@ -84,6 +84,7 @@ private:
     std::unique_ptr<AuditTrail> audit_;
     ChainReport chain_;  // the records' chain as checked at start (read by HTTP threads after)
     std::string chain_checked_at_;
+    std::atomic<bool> calibrated_{false};  // a calibration run put a new one in force
     std::unique_ptr<MeasurementStore> store_;
     std::unique_ptr<MeasurementService> service_;
     std::unique_ptr<HttpApi> api_;
@@ -111,6 +112,10 @@ Status ServiceLoop::Run() {
     service_ = std::make_unique<MeasurementService>(*store_, MakeStation(config_),
                                                     config_.storage.keep_sessions);
     service_->set_software(software_);
+    service_->set_on_calibrated([this] {
+        calibrated_ = true;
+        WakeMainLoop();
+    });
     service_->set_on_change([] { WakeMainLoop(); });
     ObserveSettings("config file " + config_file_.string() + " at start");
     if (config_.mqtt.enabled) {
@@ -191,8 +196,8 @@ void ServiceLoop::Tick() {
         next_watchdog_ = Clock::now() + notifier_.watchdog_interval();
     }
     // At run time the calibration changes only through POST /v1/calibrate (a reload observes
-    // its own changes first).
-    if (!service_->Busy()) ObserveSettings("POST /v1/calibrate");
+    // its own changes).
+    if (calibrated_.exchange(false)) ObserveSettings("POST /v1/calibrate");
     const ServiceSnapshot snapshot = service_->Snapshot();
     if (mqtt_) mqtt_->PublishState(JsonText(MqttStateJson(snapshot, config_.mqtt.station_id)));
     const std::string status = StatusLine(snapshot);
@@ -293,6 +298,8 @@ std::optional<AuditStatus> ServiceLoop::Audit() const {
     a.software = software_;
     a.chain = chain_;
     a.chain_checked_at = chain_checked_at_;
+    // The head as it is now (the check's verdict is the start's).
+    if (auto head = store_->ChainHeadHash(); head) a.chain.head = *head;
     return a;
 }
 

@@ -130,21 +130,35 @@ TEST(Weighing, AnIndicatorThatNeverSaysStableIsNotOverruled) {
     EXPECT_NEAR(*unflagged->value, 4.0, 1e-9);
 }
 
-TEST(Weighing, OverloadAndUnderloadEndTheWeighingAtOnce) {
+TEST(Weighing, AnOverloadOrUnderloadThatLastsIsTheAnswer) {
     Scripted t;
     ScriptedScale flagged(&t.now, [](double) { return ScaleReading{12.0, true, true, false}; });
     Result<Weighing> w = WeighStable(flagged, Criterion(), nullptr, t.clock);
     test::ExpectError(w, ErrorCode::kScaleError);
     EXPECT_NE(w.error().message.find("overload"), std::string::npos);
-    EXPECT_EQ(flagged.reads, 1);
+    EXPECT_NEAR(t.now, 500.0, 1e-9);  // one stable time of it, not the whole timeout
     // Above Max + 9 e without the flag is an overload all the same (OIML R76 4.2.3).
+    t.now = 0.0;
     ScriptedScale heavy(&t.now, [](double) { return ScaleReading{60.05, true, false, false}; });
     test::ExpectError(WeighStable(heavy, Criterion(), nullptr, t.clock), ErrorCode::kScaleError);
-    EXPECT_EQ(heavy.reads, 1);
+    t.now = 0.0;
     ScriptedScale under(&t.now, [](double) { return ScaleReading{-1.0, true, false, true}; });
     Result<Weighing> u = WeighStable(under, Criterion(), nullptr, t.clock);
     test::ExpectError(u, ErrorCode::kScaleError);
     EXPECT_NE(u.error().message.find("underload"), std::string::npos);
+}
+
+TEST(Weighing, AMomentsOverloadAsTheParcelIsSetDownIsMotion) {
+    Scripted t;
+    // The first 200 ms overshoot beyond Max, then the parcel rests at 20 kg.
+    ScriptedScale scale(&t.now, [](double ms) {
+        return ms < 200.0 ? ScaleReading{75.0, false, true, false}
+                          : ScaleReading{20.0, true, false, false};
+    });
+    Result<Weighing> w = WeighStable(scale, Criterion(), nullptr, t.clock);
+    ASSERT_TRUE(w.ok()) << w.error().message;
+    EXPECT_NEAR(*w->value, 20.0, 1e-9);
+    EXPECT_GE(w->settled_ms, 200.0 + 500.0);
 }
 
 TEST(Weighing, ALoadBelowMinIsWeighedButNotStated) {

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "daemon/service/measurement_store.h"
+#include "daemon/service/sqlite_db.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd {
@@ -131,6 +132,19 @@ TEST(RecordChain, RecordsFromBeforeTheChainAreCountedNotChecked) {
     EXPECT_TRUE(r.intact) << r.problem;
     EXPECT_EQ(r.records, 2);
     EXPECT_EQ(r.unchained, 1);
+}
+
+TEST(RecordChain, TheChainsStateRemovedIsFoundOffline) {
+    test::TempDir dir;
+    StoreSome(dir.path(), 2, 100);
+    Tamper(dir.path(), "DROP TABLE record_chain;");
+    // Read-only, as `boxd verify` reads it (opening the store would start a new state row).
+    auto db = OpenDatabaseReadOnly(dir.path());
+    ASSERT_TRUE(db) << db.error().message;
+    auto r = VerifyRecordChain(db->get());
+    ASSERT_TRUE(r) << r.error().message;
+    EXPECT_FALSE(r->intact);
+    EXPECT_NE(r->problem.find("state was removed"), std::string::npos) << r->problem;
 }
 
 TEST(RecordChain, TheHashIsOfTheLinkTheIdAndTheText) {

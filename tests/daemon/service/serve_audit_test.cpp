@@ -61,6 +61,12 @@ TEST(ServeAudit, IdentifiesItsSoftwareInStatusAndEveryResult) {
     ASSERT_TRUE(res);
     ASSERT_EQ(res->status, 200) << res->body;
     EXPECT_EQ(json::parse(res->body)["software"], audit["software"]);
+    // The head /v1/status publishes is the newest record's, as it is now.
+    const std::string head = Audit(daemon)["records"]["head"];
+    EXPECT_NE(head, audit["records"]["head"].get<std::string>());
+    const auto verified = test::RunBoxd({"verify", "--data-dir", (dir.path() / "data").string()});
+    ASSERT_EQ(verified.exit_code, 0) << verified.err;
+    EXPECT_EQ(json::parse(verified.out)["records"]["head"], head);
     const std::string metrics = daemon.client().Get("/metrics")->body;
     EXPECT_NE(metrics.find("\nboxd_metrological_events_total 0\n"), std::string::npos) << metrics;
     EXPECT_NE(metrics.find("\nboxd_stored_records_intact 1\n"), std::string::npos) << metrics;
