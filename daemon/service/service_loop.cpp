@@ -63,6 +63,12 @@ public:
     Status Run();
 
 private:
+    // Opens the store, the audit trail, the service, MQTT and the API (the daemon's start).
+    Status Start();
+    // Runs the loop until SIGTERM/SIGINT: ticks, the watchdog, reloads.
+    void Serve();
+    // Refuses new work, stops the table, lets the run record its abort, stops serving.
+    void Stop();
     void Reload();
     void Tick();
     // Opens the audit trail and checks the stored records' chain (logged, and kept for status).
@@ -104,6 +110,25 @@ Status ServiceLoop::Run() {
     if (!InstallSignalFlags()) {
         return Error{ErrorCode::kInternal, "cannot install the signal handlers"};
     }
+    if (Status s = Start(); !s) return s;
+    // The devices come up on their own thread (`starting`): the loop answers signals meanwhile,
+    // and a measurement requested before they are up waits for them.
+    service_->OpenStationInBackground();
+    last_status_ = StatusLine(service_->Snapshot());
+    notifier_.Ready(last_status_);
+    spdlog::info("boxd serve ready: {}", last_status_);
+    if (notifier_.watchdog_interval().count() > 0) {
+        spdlog::info("systemd watchdog: pinging every {} ms",
+                     notifier_.watchdog_interval().count());
+    }
+
+    Serve();
+    Stop();
+    spdlog::info("stopped");
+    return OkStatus();
+}
+
+Status ServiceLoop::Start() {
     auto store = MeasurementStore::Open(config_.storage.data_dir, config_.storage.retention);
     if (!store) return BadConfig("storage.data_dir: " + store.error().message);
     store_ = std::move(*store);
@@ -136,18 +161,10 @@ Status ServiceLoop::Run() {
     }
     api_->set_audit(audit_.get(), [this] { return Audit(); });
     if (Status s = api_->Start(); !s) return BadConfig(s.error().message);
+    return OkStatus();
+}
 
-    // The devices come up on their own thread (`starting`): the loop answers signals meanwhile,
-    // and a measurement requested before they are up waits for them.
-    service_->OpenStationInBackground();
-    last_status_ = StatusLine(service_->Snapshot());
-    notifier_.Ready(last_status_);
-    spdlog::info("boxd serve ready: {}", last_status_);
-    if (notifier_.watchdog_interval().count() > 0) {
-        spdlog::info("systemd watchdog: pinging every {} ms",
-                     notifier_.watchdog_interval().count());
-    }
-
+void ServiceLoop::Serve() {
     next_watchdog_ = Clock::now();
     bool terminate = false;
     while (!terminate) {
@@ -167,7 +184,9 @@ Status ServiceLoop::Run() {
             Reload();
         }
     }
+}
 
+void ServiceLoop::Stop() {
     // Shutdown: refuse new work, stop the table at once, let the run record its abort, then
     // bring the devices to rest and stop serving.
     const bool busy = service_->Busy();
@@ -183,8 +202,6 @@ Status ServiceLoop::Run() {
     api_.reset();
     service_.reset();
     mqtt_.reset();
-    spdlog::info("stopped");
-    return OkStatus();
 }
 
 void ServiceLoop::Tick() {
