@@ -104,6 +104,11 @@ Status DeviceStation::OpenLocked() {
     return OkStatus();
 }
 
+std::shared_ptr<StationDevices> DeviceStation::OpenDevices() const {
+    std::lock_guard lock(devices_mutex_);
+    return devices_;
+}
+
 void DeviceStation::MarkDeviceError(const Error& error) {
     spdlog::error("device error: {}: {}", ErrorCodeName(error.code), error.message);
     std::lock_guard lock(devices_mutex_);
@@ -133,11 +138,7 @@ Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms
     capture_ms = 0.0;
     // The capture is the devices' user until it returns: no open or close replaces them.
     std::lock_guard life(lifecycle_mutex_);
-    std::shared_ptr<StationDevices> devices;
-    {
-        std::lock_guard lock(devices_mutex_);
-        devices = devices_;
-    }
+    const std::shared_ptr<StationDevices> devices = OpenDevices();
     if (stopping_) return Error{ErrorCode::kAborted, "the daemon is stopping"};
     if (!devices || !open_) return Error{ErrorCode::kCameraError, "the devices are not open"};
     devices->turntable->ClearStopRequest();
@@ -190,11 +191,7 @@ Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms
 
 Result<std::optional<Weighing>> DeviceStation::Weigh(const JobContext& ctx) {
     std::lock_guard life(lifecycle_mutex_);
-    std::shared_ptr<StationDevices> devices;
-    {
-        std::lock_guard lock(devices_mutex_);
-        devices = devices_;
-    }
+    const std::shared_ptr<StationDevices> devices = OpenDevices();
     if (!devices || !open_) return Error{ErrorCode::kCameraError, "the devices are not open"};
     if (!devices->scale) return std::optional<Weighing>();
     if (ctx.progress) ctx.progress(JobProgress{"weighing", 0, 0});
@@ -220,11 +217,7 @@ Result<std::string> DeviceStation::ScaleCommand(const std::string& command) {
     if (!life.owns_lock()) {
         return Error{ErrorCode::kBusy, "the station is busy (a run or the devices' start)"};
     }
-    std::shared_ptr<StationDevices> devices;
-    {
-        std::lock_guard lock(devices_mutex_);
-        devices = devices_;
-    }
+    const std::shared_ptr<StationDevices> devices = OpenDevices();
     if (!devices || !open_ || !devices->scale) {
         return Error{ErrorCode::kScaleError, "the devices are not open"};
     }

@@ -58,6 +58,8 @@ public:
 private:
     // Opens the devices and homes the table; the caller holds lifecycle_mutex_.
     Status OpenLocked();
+    // Returns the devices in use (null when closed), taken under devices_mutex_.
+    std::shared_ptr<StationDevices> OpenDevices() const;
     // Records a device error: the devices are closed and reopened before the next run.
     void MarkDeviceError(const Error& error);
     // Stops the table and closes the camera; the caller holds lifecycle_mutex_.
