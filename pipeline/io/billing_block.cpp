@@ -9,12 +9,11 @@ namespace {
 
 using json = nlohmann::json;
 
-// Six significant digits' worth of a display unit: 0.0001 mm, cm³, kg or their imperial kin.
-double Tidy(double v) { return std::round(v * 1e4) / 1e4; }
-
 json Optional(const std::optional<double>& v) { return v ? json(Tidy(*v)) : json(nullptr); }
 
 }  // namespace
+
+double Tidy(double v) { return std::round(v * 1e4) / 1e4; }
 
 const char* LengthUnit(BillingUnits units) { return units == BillingUnits::kMetric ? "mm" : "in"; }
 const char* VolumeUnit(BillingUnits units) {

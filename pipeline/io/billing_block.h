@@ -19,6 +19,10 @@ inline constexpr double kKgPerLb = 0.45359237;
 // The billed dimensions in their order, as the block names them.
 inline constexpr std::array<const char*, 3> kBilledDimensions{"length", "width", "height"};
 
+// Returns `v` to 0.0001 of its display unit (mm, cm³, kg or their imperial kin), as the billing
+// and weight blocks write their figures.
+double Tidy(double v);
+
 // "mm" or "in"; "cm3" or "in3"; "kg" or "lb".
 const char* LengthUnit(BillingUnits units);
 const char* VolumeUnit(BillingUnits units);

@@ -3,17 +3,18 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "pipeline/io/billing_block.h"
+
 namespace boxd {
 
 nlohmann::json ToJson(const Weighing& w) {
     using json = nlohmann::json;
-    // A weight to a tenth of a gram's worth of digits; the division says what it is good to.
-    const auto tidy = [](double v) { return std::round(v * 1e4) / 1e4; };
+    // The division says what the weight is good to; the digits are the billing's.
     json j;
-    j["value"] = w.value ? json(tidy(*w.value)) : json(nullptr);
+    j["value"] = w.value ? json(Tidy(*w.value)) : json(nullptr);
     if (!w.value) j["why_not"] = w.why_not;
     j["unit"] = w.unit;
-    j["division"] = tidy(w.division);
+    j["division"] = Tidy(w.division);
     j["settled_ms"] = std::round(w.settled_ms);
     j["readings"] = w.readings;
     j["scale"] = w.scale;
