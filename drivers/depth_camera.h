@@ -8,6 +8,7 @@
 // reading: never averaged or filtered here (that is the pipeline's job).
 
 #include <chrono>
+#include <optional>
 #include <string>
 
 #include "pipeline/core/camera.h"
@@ -20,6 +21,17 @@ namespace boxd {
 inline Error CameraError(std::string message) {
     return Error{ErrorCode::kCameraError, std::move(message)};
 }
+
+// What the station shows on a camera's own light (the Kinect's LED).
+enum class StationLight { kOff, kIdle, kMeasuring, kFault };
+
+// What a camera's accelerometer says about its attitude.
+struct CameraTilt {
+    double tilt_deg = 0.0;   // pitch: the optical axis below the horizontal (degrees)
+    double roll_deg = 0.0;   // rotation about the optical axis
+    double motor_deg = 0.0;  // the tilt motor's own reported angle
+    double accel_mps2[3] = {0.0, 0.0, 0.0};  // the raw gravity vector, device axes
+};
 
 class DepthCamera {
 public:
@@ -38,6 +50,10 @@ public:
     virtual std::string SourceName() const = 0;
     // Returns a one-line description of the device for logs and status pages.
     virtual std::string Describe() const = 0;
+    // Returns the camera's attitude from its accelerometer, or nothing when it has none.
+    virtual std::optional<CameraTilt> Tilt() { return std::nullopt; }
+    // Shows `light` on the camera's own light, where it has one.
+    virtual void Indicate(StationLight /*light*/) {}
 };
 
 }  // namespace boxd

@@ -3,6 +3,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "drivers/freenect_camera.h"
 #include "drivers/openni2_camera.h"
 #include "drivers/replay_camera.h"
 #include "drivers/replay_turntable.h"
@@ -21,6 +22,10 @@ Result<std::unique_ptr<DepthCamera>> MakeDepthCamera(const CameraConfig& config,
     if (config.driver == "openni2") {
         return std::unique_ptr<DepthCamera>(std::make_unique<OpenNi2Camera>(
             config.openni2, config.intrinsics, config.depth_unit_m));
+    }
+    if (config.driver == "freenect") {
+        return std::unique_ptr<DepthCamera>(std::make_unique<FreenectCamera>(
+            config.freenect, config.intrinsics, config.depth_unit_m));
     }
     if (config.driver == "simulated") {
         if (!turntable) return CameraError("simulated camera: needs the station's turntable");

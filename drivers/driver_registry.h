@@ -1,7 +1,7 @@
 #pragma once
 // The driver registry: builds the devices a station config names (gpsd style: one small
 // interface per device kind, the implementation picked by a config string).
-//   camera.driver: openni2 | simulated | replay
+//   camera.driver: openni2 | freenect | simulated | replay
 //   turntable.driver: modbus-tcp | modbus-rtu | simulated (MakeTurntable); a replay camera
 //   brings its own replay turntable and the turntable section is not used.
 //   scale.driver: none | modbus-tcp | modbus-rtu | simulated (MakeScale).

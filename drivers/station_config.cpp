@@ -137,12 +137,36 @@ Status ReadSimulated(const YAML::Node& node, const std::string& key, SimulatedCa
         });
 }
 
+// The `camera.freenect:` section; `tilt_deg` may be absent (the motor is left alone).
+Status ReadFreenect(const YAML::Node& node, const std::string& key, FreenectCameraConfig& c) {
+    double tilt = 0.0;
+    bool has_tilt = false;
+    const Reader tilt_reader = [&](const YAML::Node& n, const std::string& k) {
+        has_tilt = true;
+        return Value(tilt)(n, k);
+    };
+    if (auto st = ReadMap(node, key,
+                          {{"index", Value(c.index)},
+                           {"serial", Value(c.serial)},
+                           {"depth_format", Value(c.depth_format)},
+                           {"tilt_deg", tilt_reader},
+                           {"led", Value(c.led)},
+                           {"recover_attempts", Value(c.recover_attempts)},
+                           {"reopen_delay_ms", Value(c.reopen_delay_ms)}});
+        !st) {
+        return st;
+    }
+    if (has_tilt) c.tilt_deg = tilt;
+    return OkStatus();
+}
+
 }  // namespace
 
 Status CameraConfig::Validate() const {
-    if (driver != "openni2" && driver != "simulated" && driver != "replay") {
+    if (driver != "openni2" && driver != "freenect" && driver != "simulated" &&
+        driver != "replay") {
         return KeyError("camera.driver",
-                        "must be openni2, simulated or replay, got '" + driver + "'");
+                        "must be openni2, freenect, simulated or replay, got '" + driver + "'");
     }
     if (!(depth_unit_m > 0.0) || depth_unit_m > 0.1) {
         return KeyError("camera.depth_unit_m", "must be in (0, 0.1] metres");
@@ -153,6 +177,7 @@ Status CameraConfig::Validate() const {
         }
     }
     if (driver == "openni2") return openni2.Validate();
+    if (driver == "freenect") return freenect.Validate();
     if (driver == "simulated") return simulated.Validate();
     return replay.Validate();
 }
@@ -178,6 +203,8 @@ Result<CameraConfig> ParseCameraConfig(const YAML::Node& node) {
                 {"intrinsics", Intrinsics(c.intrinsics)},
                 {"openni2",
                  [&](const YAML::Node& n, const std::string& k) { return ReadMap(n, k, openni2); }},
+                {"freenect", [&](const YAML::Node& n,
+                                 const std::string& k) { return ReadFreenect(n, k, c.freenect); }},
                 {"simulated",
                  [&](const YAML::Node& n, const std::string& k) {
                      return ReadSimulated(n, k, c.simulated);

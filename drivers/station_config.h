@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "drivers/capture_loop.h"
+#include "drivers/freenect_camera.h"
 #include "drivers/openni2_camera.h"
 #include "drivers/replay_source.h"
 #include "drivers/scale.h"
@@ -25,12 +26,13 @@ namespace boxd {
 
 // The `camera:` section.
 struct CameraConfig {
-    std::string driver = "openni2";  // openni2 | simulated | replay
+    std::string driver = "openni2";  // openni2 | freenect | simulated | replay
     double depth_unit_m = 0.001;     // unit of the recorded frames
     // fx, fy, cx, cy (and the width/height they belong to); for openni2 they replace the ones
     // derived from the stream's field of view, for simulated they are the rendered camera's.
     std::optional<CameraIntrinsics> intrinsics;
     OpenNi2CameraConfig openni2;
+    FreenectCameraConfig freenect;
     SimulatedCameraConfig simulated;
     ReplayConfig replay;
 

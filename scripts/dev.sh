@@ -16,7 +16,7 @@ cd "$(dirname "$0")/.."
 PACKAGES=(
     build-essential cmake pkg-config git ca-certificates
     libeigen3-dev libpcl-dev libopencv-dev libceres-dev
-    libmodbus-dev libopenni2-dev libusb-1.0-0-dev
+    libmodbus-dev libopenni2-dev libfreenect-dev libusb-1.0-0-dev
     libyaml-cpp-dev nlohmann-json3-dev libcpp-httplib-dev libcli11-dev libspdlog-dev
     libsqlite3-dev libssl-dev libsystemd-dev libgtest-dev libembree-dev libpng-dev libdeflate-dev libmosquitto-dev
     mosquitto mosquitto-clients

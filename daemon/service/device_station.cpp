@@ -101,6 +101,7 @@ Status DeviceStation::OpenLocked() {
         open_ = true;
     }
     spdlog::info("devices up: turntable {}; camera {}", turntable, camera);
+    OpenDevices()->camera->Indicate(StationLight::kIdle);
     return OkStatus();
 }
 
@@ -175,17 +176,17 @@ Result<Session> DeviceStation::Capture(const JobContext& ctx, double& capture_ms
     }
     const auto t_capture = std::chrono::steady_clock::now();
     last_frame_at_ = t_capture;
+    devices->camera->Indicate(StationLight::kMeasuring);
     Result<Session> session =
         CaptureSession(*devices->turntable, *devices->camera, capture, devices->station, callbacks);
     // Up to the last frame: what comes after it (a last measurement so far) is processing.
     capture_ms = std::chrono::duration<double, std::milli>(
                      (preparer ? last_frame_at_ : std::chrono::steady_clock::now()) - t_capture)
                      .count();
-    if (!session) {
-        const Error& e = session.error();
-        if (e.code == ErrorCode::kTurntableError || e.code == ErrorCode::kCameraError)
-            MarkDeviceError(e);
-    }
+    const bool device_fault = !session && (session.error().code == ErrorCode::kTurntableError ||
+                                           session.error().code == ErrorCode::kCameraError);
+    devices->camera->Indicate(device_fault ? StationLight::kFault : StationLight::kIdle);
+    if (device_fault) MarkDeviceError(session.error());
     return session;
 }
 
@@ -324,17 +325,24 @@ DeviceHealth DeviceStation::Devices() const {
         return device_error_ && !description.empty() &&
                (device_error_->code == other || device_error_->code == ErrorCode::kScaleError);
     };
-    return DeviceHealth{
-        DeviceState{config_.station.turntable.driver, turntable_description_,
-                    open || closed_by(ErrorCode::kCameraError, turntable_description_)},
-        DeviceState{config_.station.camera.driver, camera_description_,
-                    open || closed_by(ErrorCode::kTurntableError, camera_description_)},
+    DeviceHealth health{
+        DeviceState{config_.station.turntable.driver,
+                    turntable_description_,
+                    open || closed_by(ErrorCode::kCameraError, turntable_description_),
+                    {}},
+        DeviceState{config_.station.camera.driver,
+                    camera_description_,
+                    open || closed_by(ErrorCode::kTurntableError, camera_description_),
+                    {}},
         config_.station.scale.enabled()
-            ? std::optional<DeviceState>(DeviceState{config_.station.scale.driver,
-                                                     scale_description_, open && !scale_error_})
+            ? std::optional<DeviceState>(DeviceState{
+                  config_.station.scale.driver, scale_description_, open && !scale_error_, {}})
             : std::nullopt,
         scale_error_ && !device_error_ ? scale_error_ : device_error_,
     };
+    // The camera's own attitude, where it has an accelerometer: a knocked camera shows here.
+    if (devices_ && devices_->camera) health.camera.tilt = devices_->camera->Tilt();
+    return health;
 }
 
 }  // namespace boxd

@@ -9,9 +9,15 @@ using nlohmann::json;
 namespace {
 
 json DeviceJson(const DeviceState& d) {
-    return {{"driver", d.driver},
-            {"description", d.description.empty() ? json(nullptr) : json(d.description)},
-            {"ok", d.ok}};
+    json j = {{"driver", d.driver},
+              {"description", d.description.empty() ? json(nullptr) : json(d.description)},
+              {"ok", d.ok}};
+    if (d.tilt) {
+        j["tilt_deg"] = d.tilt->tilt_deg;
+        j["roll_deg"] = d.tilt->roll_deg;
+        j["motor_deg"] = d.tilt->motor_deg;
+    }
+    return j;
 }
 
 json OptionalString(const std::string& s) { return s.empty() ? json(nullptr) : json(s); }

@@ -12,6 +12,7 @@
 
 #include "calibration/station_calibrator.h"
 #include "daemon/service/measurement_store.h"
+#include "drivers/depth_camera.h"
 #include "pipeline/core/result.h"
 #include "pipeline/core/station_calibration.h"
 #include "pipeline/io/measurement.h"
@@ -48,6 +49,7 @@ struct DeviceState {
     std::string driver;       // the config's driver name ("modbus-tcp", "simulated", ...)
     std::string description;  // what the opened device says it is; empty until it was opened
     bool ok = false;          // open, and no device error since
+    std::optional<CameraTilt> tilt;  // the camera's accelerometer (a Kinect's), when it has one
 };
 
 // The devices' description and health (GET /v1/status "devices").

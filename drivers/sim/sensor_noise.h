@@ -10,6 +10,7 @@
 #include <limits>
 #include <string>
 
+#include "pipeline/core/kinect_disparity.h"
 #include "pipeline/core/result.h"
 
 namespace boxd {
@@ -63,11 +64,6 @@ struct SensorNoiseParams {
 // Returns the parameters of the sensor class `model` (kNone: an ideal sensor).
 SensorNoiseParams DefaultSensorNoise(NoiseModel model);
 
-// Kinect v1 disparity conversion constants (OpenKinect / ROS openni_camera).
-inline constexpr double kKinectDisparityScale = -0.0030711016;
-inline constexpr double kKinectDisparityOffset = 3.3309495161;
-inline constexpr int kKinectMaxRawDisparity = 2046;  // 2047 marks "no reading" in the stream
-
 // The formulas below are inline: the renderer evaluates them for every pixel of every frame.
 
 // Returns the Kinect v1 axial sigma (m) at z-depth `z_m` and incidence angle `incidence_rad`:
@@ -112,36 +108,6 @@ inline double AxialSigma(const SensorNoiseParams& params, double z_m, double inc
             return ToFAxialSigma(z_m, incidence_rad, params.tof_sigma_m);
     }
     return 0.0;
-}
-
-// Kinect v1 11-bit disparity: z = 1 / (raw * -0.0030711016 + 3.3309495161) (the OpenKinect /
-// ROS openni_camera depth conversion). Returns the raw disparity of `z_m`, not rounded.
-inline double KinectRawDisparity(double z_m) {
-    constexpr double kInverseScale = 1.0 / kKinectDisparityScale;
-    return (1.0 / z_m - kKinectDisparityOffset) * kInverseScale;
-}
-
-// The z-depth of every raw disparity 0..2046 (0 where the formula gives none).
-using KinectDepthTable = std::array<double, kKinectMaxRawDisparity + 1>;
-// Returns the table of z-depths of the raw disparities (built once).
-const KinectDepthTable& KinectDisparityDepths();
-
-// Returns the z-depth of integer raw disparity `raw`, or 0 where the formula gives no depth.
-inline double KinectDepthOfDisparity(int raw) {
-    if (raw < 0 || raw > kKinectMaxRawDisparity) return 0.0;
-    return KinectDisparityDepths()[static_cast<std::size_t>(raw)];
-}
-
-// Returns `z_m` snapped to the nearest 11-bit disparity level, or 0 if it has none; `levels` is
-// KinectDisparityDepths() (passed in so that per-pixel callers fetch it once).
-inline double KinectQuantiseDepth(double z_m, const KinectDepthTable& levels) {
-    if (!(z_m > 0.0)) return 0.0;
-    const double raw = KinectRawDisparity(z_m);
-    if (!(raw > -0.5 && raw < kKinectMaxRawDisparity + 0.5)) return 0.0;
-    return levels[static_cast<std::size_t>(std::lround(raw))];
-}
-inline double KinectQuantiseDepth(double z_m) {
-    return KinectQuantiseDepth(z_m, KinectDisparityDepths());
 }
 
 }  // namespace boxd

@@ -1,0 +1,397 @@
+#include "drivers/freenect_camera.h"
+
+#include <dlfcn.h>
+#include <libfreenect.h>
+#include <libfreenect_registration.h>
+#include <spdlog/spdlog.h>
+#include <sys/time.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+#include "drivers/freenect_dump.h"
+
+namespace boxd {
+
+// freenect_dump.cpp writes accelerometer records of this size.
+static_assert(sizeof(freenect_raw_tilt_state) == 12, "libfreenect's tilt state layout changed");
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+Error ConfigError(const std::string& field, const std::string& what) {
+    return Error{ErrorCode::kInvalidInput, "camera.freenect." + field + ": " + what};
+}
+
+// Whether the libfreenect this process runs on is fakenect, Debian's replay library (it sits in
+// the library folder's fakenect/ and is chosen with LD_LIBRARY_PATH).
+bool RunningOnFakenect() {
+    Dl_info info{};
+    void* init = dlsym(RTLD_DEFAULT, "freenect_init");
+    if (!init || !dladdr(init, &info) || !info.dli_fname) return false;
+    return std::string(info.dli_fname).find("/fakenect/") != std::string::npos;
+}
+
+void LogFromLibrary(freenect_context*, freenect_loglevel level, const char* message) {
+    std::string text = message ? message : "";
+    while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
+    if (level <= FREENECT_LOG_ERROR) {
+        spdlog::warn("libfreenect: {}", text);
+    } else {
+        spdlog::debug("libfreenect: {}", text);
+    }
+}
+
+freenect_led_options LedOf(StationLight light) {
+    switch (light) {
+        case StationLight::kIdle:
+            return LED_GREEN;
+        case StationLight::kMeasuring:
+            return LED_BLINK_GREEN;
+        case StationLight::kFault:
+            return LED_RED;
+        case StationLight::kOff:
+            break;
+    }
+    return LED_OFF;
+}
+
+// The device's zero-plane data, through freenect_copy_registration where the library has it
+// (looked up at run time: fakenect lacks it, and boxd must start on both).
+std::optional<CameraIntrinsics> DeviceIntrinsics(freenect_device* dev) {
+    using Copy = freenect_registration (*)(freenect_device*);
+    using Destroy = int (*)(freenect_registration*);
+    auto copy = reinterpret_cast<Copy>(dlsym(RTLD_DEFAULT, "freenect_copy_registration"));
+    auto destroy = reinterpret_cast<Destroy>(dlsym(RTLD_DEFAULT, "freenect_destroy_registration"));
+    if (!copy || !destroy) return std::nullopt;
+    freenect_registration reg = copy(dev);
+    const double distance = reg.zero_plane_info.reference_distance;
+    const double pixel = reg.zero_plane_info.reference_pixel_size;
+    destroy(&reg);
+    if (!(distance > 10.0 && distance < 1000.0) || !(pixel > 0.001 && pixel < 1.0)) {
+        return std::nullopt;
+    }
+    return KinectIntrinsics(distance, pixel);
+}
+
+}  // namespace
+
+CameraIntrinsics KinectIntrinsics(double reference_distance_mm, double reference_pixel_size_mm) {
+    CameraIntrinsics k;
+    k.width = kKinectDepthWidth;
+    k.height = kKinectDepthHeight;
+    k.fx = k.fy = reference_distance_mm / (2.0 * reference_pixel_size_mm);
+    k.cx = kKinectDepthWidth / 2.0;
+    k.cy = kKinectDepthHeight / 2.0;
+    return k;
+}
+
+Status FreenectCameraConfig::Validate() const {
+    if (index < 0 || index > 15) return ConfigError("index", "must be 0..15");
+    if (depth_format != "auto" && depth_format != "mm" && depth_format != "11bit") {
+        return ConfigError("depth_format", "must be auto, mm or 11bit, got '" + depth_format + "'");
+    }
+    if (tilt_deg && !(*tilt_deg >= -27.0 && *tilt_deg <= 27.0)) {
+        return ConfigError("tilt_deg", "must be -27..27 (the motor's range)");
+    }
+    if (recover_attempts < 0 || recover_attempts > 10) {
+        return ConfigError("recover_attempts", "must be 0..10");
+    }
+    if (reopen_delay_ms < 0 || reopen_delay_ms > 60'000) {
+        return ConfigError("reopen_delay_ms", "must be 0..60000");
+    }
+    return OkStatus();
+}
+
+struct FreenectCamera::Impl {
+    FreenectCameraConfig config;
+    std::optional<CameraIntrinsics> override_intrinsics;
+    double depth_unit_m = 0.001;
+
+    std::mutex mutex;  // held around every libfreenect call
+    freenect_context* ctx = nullptr;
+    freenect_device* dev = nullptr;
+    bool open = false;
+    bool replay = false;  // fakenect replaying the dump in FAKENECT_PATH
+    std::string dump;     // that dump
+    freenect_depth_format format = FREENECT_DEPTH_11BIT;
+    CameraIntrinsics intrinsics;
+    std::vector<std::uint16_t> frame;  // the last depth frame the library delivered
+    bool fresh = false;                // set by the depth callback
+    long frames = 0;                   // frames delivered since Open
+    std::mutex tilt_mutex;             // guards `tilt`, read by status pages
+    std::optional<CameraTilt> tilt;    // the last accelerometer reading
+    std::atomic<int> light{-1};        // a StationLight waiting to be shown
+
+    std::string Where() const {
+        if (replay) return "freenect replay " + dump;
+        return "freenect " +
+               (config.serial.empty() ? "#" + std::to_string(config.index) : config.serial);
+    }
+
+    static void OnDepth(freenect_device* dev, void* data, std::uint32_t) {
+        auto* self = static_cast<Impl*>(freenect_get_user(dev));
+        const auto* values = static_cast<const std::uint16_t*>(data);
+        self->frame.assign(values, values + kKinectDepthWidth * kKinectDepthHeight);
+        self->fresh = true;
+    }
+
+    Status OpenOnce();
+    Status OpenDevice();
+    Result<freenect_frame_mode> ChooseMode() const;
+    void CloseDevice();
+    Result<DepthImage> ReadOne(std::chrono::milliseconds timeout);
+    DepthImage Convert() const;
+    void ReadTilt();
+    void ShowLight();
+};
+
+Result<freenect_frame_mode> FreenectCamera::Impl::ChooseMode() const {
+    std::optional<freenect_frame_mode> mm, raw;
+    for (int i = 0; i < freenect_get_depth_mode_count(); ++i) {
+        const freenect_frame_mode m = freenect_get_depth_mode(i);
+        if (!m.is_valid || m.resolution != FREENECT_RESOLUTION_MEDIUM) continue;
+        if (m.depth_format == FREENECT_DEPTH_MM) mm = m;
+        if (m.depth_format == FREENECT_DEPTH_11BIT) raw = m;
+    }
+    if (config.depth_format != "11bit" && mm) return *mm;
+    if (config.depth_format == "mm") {
+        return CameraError(Where() + ": this libfreenect offers no millimetre depth (a fakenect " +
+                           "replay streams raw 11-bit only); set camera.freenect.depth_format to "
+                           "auto or 11bit");
+    }
+    if (!raw) return CameraError(Where() + ": libfreenect offers no 640 x 480 11-bit depth mode");
+    return *raw;
+}
+
+Status FreenectCamera::Impl::OpenDevice() {
+    const int count = freenect_num_devices(ctx);
+    if (count <= 0) {
+        return CameraError(Where() +
+                           ": no Kinect found (`boxd devices` lists the USB cameras; "
+                           "is the Kinect's power supply plugged in?)");
+    }
+    const int rc = config.serial.empty()
+                       ? (config.index < count ? freenect_open_device(ctx, &dev, config.index) : -1)
+                       : freenect_open_device_by_camera_serial(ctx, &dev, config.serial.c_str());
+    if (rc < 0 || !dev) {
+        dev = nullptr;
+        return CameraError(Where() + ": cannot open the device (" + std::to_string(count) +
+                           " Kinect(s) attached; the boxd user needs the plugdev group)");
+    }
+    auto mode = ChooseMode();
+    if (!mode) return mode.error();
+    if (freenect_set_depth_mode(dev, *mode) < 0) {
+        return CameraError(Where() + ": cannot set the 640 x 480 depth mode");
+    }
+    format = mode->depth_format;
+    freenect_set_user(dev, this);
+    freenect_set_depth_callback(dev, &Impl::OnDepth);
+    if (freenect_start_depth(dev) < 0)
+        return CameraError(Where() + ": cannot start the depth stream");
+    if (config.tilt_deg && freenect_set_tilt_degs(dev, *config.tilt_deg) < 0) {
+        spdlog::warn("{}: the tilt motor did not take {} degrees", Where(), *config.tilt_deg);
+    }
+    return OkStatus();
+}
+
+Status FreenectCamera::Impl::OpenOnce() {
+    replay = RunningOnFakenect();
+    if (replay) {
+        // fakenect ends the process on a dump it cannot read: check it first.
+        const char* path = std::getenv("FAKENECT_PATH");
+        if (!path || !*path) {
+            return CameraError(
+                "freenect: the fakenect replay library is loaded but FAKENECT_PATH "
+                "names no dump folder");
+        }
+        dump = path;
+        if (auto index = CheckDump(dump); !index) return index.error();
+    }
+    std::lock_guard lock(mutex);
+    if (freenect_init(&ctx, nullptr) < 0) {
+        ctx = nullptr;
+        return CameraError(Where() + ": libfreenect cannot start (libusb)");
+    }
+    freenect_set_log_level(ctx, FREENECT_LOG_WARNING);
+    freenect_set_log_callback(ctx, &LogFromLibrary);
+    const bool motor = config.tilt_deg.has_value() || config.led;
+    freenect_select_subdevices(
+        ctx, static_cast<freenect_device_flags>(FREENECT_DEVICE_CAMERA |
+                                                (motor ? FREENECT_DEVICE_MOTOR : 0)));
+    if (auto st = OpenDevice(); !st) {
+        CloseDevice();
+        return st;
+    }
+    intrinsics = override_intrinsics ? *override_intrinsics
+                                     : DeviceIntrinsics(dev).value_or(KinectIntrinsics());
+    intrinsics.depth_unit_m = depth_unit_m;
+    open = true;
+    frames = 0;
+    spdlog::info("{}: depth 640x480 {} fx={:.1f} cx={:.1f} cy={:.1f}", Where(),
+                 format == FREENECT_DEPTH_MM ? "mm (device calibration)" : "11-bit disparity",
+                 intrinsics.fx, intrinsics.cx, intrinsics.cy);
+    return OkStatus();
+}
+
+void FreenectCamera::Impl::CloseDevice() {
+    if (dev) {
+        freenect_stop_depth(dev);
+        freenect_close_device(dev);
+        dev = nullptr;
+    }
+    if (ctx) {
+        freenect_shutdown(ctx);
+        ctx = nullptr;
+    }
+    open = false;
+}
+
+DepthImage FreenectCamera::Impl::Convert() const {
+    DepthImage image(kKinectDepthWidth, kKinectDepthHeight);
+    if (format == FREENECT_DEPTH_MM) {
+        const double scale = 0.001 / depth_unit_m;
+        for (std::size_t i = 0; i < frame.size(); ++i) {
+            const double v = std::round(frame[i] * scale);
+            image.pixels[i] = v <= 65535.0 ? static_cast<std::uint16_t>(v) : 0;
+        }
+    } else {
+        image.pixels = RawDisparityToDepth(frame, depth_unit_m);
+    }
+    return image;
+}
+
+Result<DepthImage> FreenectCamera::Impl::ReadOne(std::chrono::milliseconds timeout) {
+    const Clock::time_point deadline = Clock::now() + timeout;
+    fresh = false;
+    while (!fresh) {
+        const auto left =
+            std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now());
+        if (left.count() <= 0) {
+            return CameraError(Where() + ": no depth frame within " +
+                               std::to_string(timeout.count()) + " ms");
+        }
+        timeval tv{0, static_cast<suseconds_t>(std::min<long long>(left.count(), 100'000))};
+        int rc = 0;
+        {
+            std::lock_guard lock(mutex);
+            rc = freenect_process_events_timeout(ctx, &tv);
+        }
+        if (rc < 0 && replay) {
+            return CameraError(Where() + ": the recording ended after " + std::to_string(frames) +
+                               " depth frames");
+        }
+        if (rc < 0)
+            return CameraError(Where() + ": the USB link failed (libfreenect " +
+                               std::to_string(rc) + ")");
+    }
+    ++frames;
+    return Convert();
+}
+
+void FreenectCamera::Impl::ReadTilt() {
+    if (!dev) return;
+    freenect_update_tilt_state(dev);
+    freenect_raw_tilt_state* state = freenect_get_tilt_state(dev);
+    if (!state) return;
+    CameraTilt t;
+    freenect_get_mks_accel(state, &t.accel_mps2[0], &t.accel_mps2[1], &t.accel_mps2[2]);
+    const double g = std::hypot(t.accel_mps2[0], t.accel_mps2[1], t.accel_mps2[2]);
+    if (!(g > 1.0)) return;  // no reading (a dump without accelerometer records)
+    constexpr double kDeg = 180.0 / M_PI;
+    // Level, the Kinect's y axis holds gravity; pitching the optical axis (z) moves it into z.
+    t.tilt_deg = std::asin(std::clamp(t.accel_mps2[2] / g, -1.0, 1.0)) * kDeg;
+    t.roll_deg = std::atan2(t.accel_mps2[0], t.accel_mps2[1]) * kDeg;
+    t.motor_deg = freenect_get_tilt_degs(state);
+    std::lock_guard lock(tilt_mutex);
+    tilt = t;
+}
+
+void FreenectCamera::Impl::ShowLight() {
+    const int pending = light.exchange(-1);
+    if (pending < 0 || !dev || !config.led) return;
+    freenect_set_led(dev, LedOf(static_cast<StationLight>(pending)));
+}
+
+FreenectCamera::FreenectCamera(FreenectCameraConfig config,
+                               std::optional<CameraIntrinsics> intrinsics, double depth_unit_m)
+    : impl_(std::make_unique<Impl>()) {
+    impl_->config = std::move(config);
+    impl_->override_intrinsics = std::move(intrinsics);
+    impl_->depth_unit_m = depth_unit_m;
+}
+
+FreenectCamera::~FreenectCamera() { Close(); }
+
+Status FreenectCamera::Open() {
+    if (impl_->open) return OkStatus();
+    if (auto st = impl_->config.Validate(); !st) return CameraError(st.error().message);
+    if (!(impl_->depth_unit_m > 0.0)) return CameraError("freenect: depth unit must be positive");
+    if (impl_->override_intrinsics && (impl_->override_intrinsics->width != kKinectDepthWidth ||
+                                       impl_->override_intrinsics->height != kKinectDepthHeight)) {
+        return CameraError("freenect: camera.intrinsics must be for 640 x 480");
+    }
+    if (auto st = impl_->OpenOnce(); !st) return st;
+    std::lock_guard lock(impl_->mutex);
+    impl_->ReadTilt();
+    impl_->ShowLight();
+    return OkStatus();
+}
+
+CameraIntrinsics FreenectCamera::Intrinsics() const { return impl_->intrinsics; }
+
+Result<DepthImage> FreenectCamera::Grab(std::chrono::milliseconds timeout) {
+    if (!impl_->open) return CameraError(impl_->Where() + ": camera is not open");
+    auto frame = impl_->ReadOne(timeout);
+    // A replay that ended does not come back by reopening; a live device may.
+    for (int attempt = 1; !frame && !impl_->replay && attempt <= impl_->config.recover_attempts;
+         ++attempt) {
+        spdlog::warn("{}; reopening the device ({} of {})", frame.error().message, attempt,
+                     impl_->config.recover_attempts);
+        {
+            std::lock_guard lock(impl_->mutex);
+            impl_->CloseDevice();
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(impl_->config.reopen_delay_ms));
+        if (auto st = impl_->OpenOnce(); !st) {
+            frame = st.error();
+            continue;
+        }
+        frame = impl_->ReadOne(timeout);
+    }
+    std::lock_guard lock(impl_->mutex);
+    if (frame) impl_->ReadTilt();
+    impl_->ShowLight();
+    return frame;
+}
+
+void FreenectCamera::Close() {
+    if (!impl_) return;
+    std::lock_guard lock(impl_->mutex);
+    impl_->CloseDevice();
+}
+
+std::string FreenectCamera::Describe() const { return impl_->Where(); }
+
+std::optional<CameraTilt> FreenectCamera::Tilt() {
+    // Fresh from the device between measurements; during one, the last frame's reading.
+    std::unique_lock lock(impl_->mutex, std::try_to_lock);
+    if (lock.owns_lock()) impl_->ReadTilt();
+    std::lock_guard tilt_lock(impl_->tilt_mutex);
+    return impl_->tilt;
+}
+
+void FreenectCamera::Indicate(StationLight light) {
+    impl_->light = static_cast<int>(light);
+    std::unique_lock lock(impl_->mutex, std::try_to_lock);
+    if (lock.owns_lock()) impl_->ShowLight();  // else the next Grab shows it
+}
+
+}  // namespace boxd

@@ -1,0 +1,189 @@
+// The Kinect station through the real binary and Debian's fakenect: a dump written from the
+// simulated station's frames in the Kinect's own 11-bit encoding is replayed by `boxd record`
+// and `boxd serve` with camera.driver freenect, and broken dumps end in CAMERA_ERROR, never in a
+// hang or a crash.
+#include <gtest/gtest.h>
+#include <yaml-cpp/yaml.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "drivers/freenect_dump.h"
+#include "drivers/station_config.h"
+#include "pipeline/io/session_io.h"
+#include "tests/support/run_command.h"
+#include "tests/support/serve_daemon.h"
+#include "tests/support/simulated_kinect.h"
+#include "tests/support/temp_dir.h"
+
+namespace boxd {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+// The simulated station of config/sim.yaml: its box, camera placement, noise and errors.
+SyntheticStationConfig SimStation() {
+    auto config = LoadStationConfig(test::SimConfigPath());
+    EXPECT_TRUE(config.ok());
+    return config->camera.simulated.station;
+}
+
+// config/sim.yaml with its camera replaced by a Kinect (and that camera's calibration), the
+// capture's poses and frames as given.
+fs::path KinectConfig(const fs::path& dir, int poses, int frames, int drop) {
+    YAML::Node root = YAML::LoadFile(test::SimConfigPath().string());
+    root["camera"] = YAML::Load("driver: freenect\nfreenect: {led: true}\n");
+    root["capture"]["poses"] = poses;
+    root["capture"]["frames_per_pose"] = frames;
+    root["capture"]["drop_frames"] = drop;
+    root["turntable"]["speed_dps"] = 720;
+    root.remove("calibration");
+    root.remove("scale");
+    YAML::Emitter out;
+    out << root;
+    const fs::path path = dir / "kinect.yaml";
+    std::ofstream(path) << out.c_str() << "\n" << test::CalibrationYaml(SimStation());
+    return path;
+}
+
+// Runs boxd with `args` on fakenect replaying `dump` (at most a minute: a hang fails).
+test::CommandOutput RunOnFakenect(const fs::path& dump, const std::vector<std::string>& args) {
+    std::vector<std::string> argv = {"timeout", "60", "env"};
+    for (const auto& e : test::FakenectEnv(dump)) argv.push_back(e);
+    argv.push_back(BOXD_BINARY);
+    argv.insert(argv.end(), args.begin(), args.end());
+    return test::RunCommand(argv);
+}
+
+std::vector<double> Angles(int poses, const std::string& order) {
+    CaptureConfig c;
+    c.poses = poses;
+    c.order = order;
+    return c.Angles();
+}
+
+TEST(FreenectStation, RecordReplaysTheDumpAndTheSessionMeasuresTheBox) {
+    test::TempDir dir;
+    test::KinectDumpPlan plan;
+    plan.angles_deg = Angles(12, "sequential");
+    plan.frames_per_angle = 3;  // one dropped, two kept
+    ASSERT_TRUE(test::WriteSimulatedKinectDump(dir / "dump", SimStation(), plan).ok());
+    const fs::path config = KinectConfig(dir.path(), 12, 2, 1);
+
+    const auto rec = RunOnFakenect(
+        dir / "dump", {"record", "--config", config.string(), "--out", (dir / "session").string()});
+    ASSERT_EQ(rec.exit_code, 0) << rec.err;
+    auto session = LoadSession(dir / "session");
+    ASSERT_TRUE(session.ok()) << session.error().message;
+    EXPECT_EQ(session->source, "freenect");
+    EXPECT_NEAR(session->camera.fx, 575.816, 0.001);
+    EXPECT_EQ(session->camera.cx, 320.0);
+    ASSERT_EQ(session->poses.size(), 12u);
+    EXPECT_EQ(session->poses[0].frames.size(), 2u);
+
+    const auto m = test::RunBoxd({"measure", "--session", (dir / "session").string()});
+    ASSERT_EQ(m.exit_code, 0) << m.err;
+    const json j = json::parse(m.out);
+    const SyntheticBox box = SimStation().box;
+    EXPECT_NEAR(j["dimensions"]["length_m"].get<double>(), box.length_m, 0.002) << j.dump();
+    EXPECT_NEAR(j["dimensions"]["width_m"].get<double>(), box.width_m, 0.002);
+    EXPECT_NEAR(j["dimensions"]["height_m"].get<double>(), box.height_m, 0.002);
+}
+
+TEST(FreenectStation, ServeMeasuresTheSimulatedBoxOverHttp) {
+    test::TempDir dir;
+    test::KinectDumpPlan plan;
+    plan.angles_deg = Angles(18, "coverage");
+    plan.frames_per_angle = 3;
+    plan.accel_tilt_deg = 30.0;
+    ASSERT_TRUE(test::WriteSimulatedKinectDump(dir / "dump", SimStation(), plan).ok());
+    test::ServeDaemon daemon(KinectConfig(dir.path(), 18, 3, 0), dir / "data", dir / "boxd.log",
+                             test::FakenectEnv(dir / "dump"));
+    ASSERT_TRUE(daemon.WaitHealthy()) << test::ReadText(dir / "boxd.log");
+
+    auto res = daemon.client().Post("/v1/measure?wait=1", "", "application/json");
+    ASSERT_TRUE(res);
+    ASSERT_EQ(res->status, 200) << res->body << test::ReadText(dir / "boxd.log");
+    const json j = json::parse(res->body);
+    ASSERT_EQ(j["status"], "ok") << j.dump();
+    const SyntheticBox box = SimStation().box;
+    EXPECT_NEAR(j["dimensions"]["length_m"].get<double>(), box.length_m, 0.001) << j.dump();
+    EXPECT_NEAR(j["dimensions"]["width_m"].get<double>(), box.width_m, 0.001);
+    EXPECT_NEAR(j["dimensions"]["height_m"].get<double>(), box.height_m, 0.001);
+
+    // The dump's accelerometer record (read as the replay reaches it): the camera's attitude.
+    const json status = daemon.GetJson("/v1/status");
+    EXPECT_EQ(status["devices"]["camera"]["driver"], "freenect") << status.dump();
+    EXPECT_TRUE(status["devices"]["camera"]["ok"].get<bool>());
+    ASSERT_TRUE(status["devices"]["camera"].contains("tilt_deg")) << status.dump();
+    EXPECT_NEAR(status["devices"]["camera"]["tilt_deg"].get<double>(), 30.0, 0.2);
+    EXPECT_NEAR(status["devices"]["camera"]["roll_deg"].get<double>(), 0.0, 0.2);
+}
+
+// `boxd record` against a broken dump: exit 1 with CAMERA_ERROR saying what is wrong.
+void ExpectRecordFails(const fs::path& dir, const fs::path& dump, const std::string& says) {
+    const fs::path config = KinectConfig(dir, 4, 2, 0);
+    const auto r = RunOnFakenect(
+        dump, {"record", "--config", config.string(), "--out", (dir / "out").string()});
+    EXPECT_EQ(r.exit_code, 1) << r.err;  // not 124 (a hang) nor a signal
+    EXPECT_NE(r.err.find("CAMERA_ERROR"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(says), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out" / "session.json"));
+}
+
+TEST(FreenectStation, BrokenDumpsGiveCameraError) {
+    test::TempDir dir;
+    test::KinectDumpPlan plan;
+    plan.angles_deg = {0.0, 90.0, 180.0, 270.0};
+    plan.frames_per_angle = 2;
+    const fs::path dump = dir / "dump";
+    ASSERT_TRUE(test::WriteSimulatedKinectDump(dump, SimStation(), plan).ok());
+    std::vector<std::string> lines;
+    {
+        std::ifstream in(dump / "INDEX.txt");
+        for (std::string l; std::getline(in, l);) lines.push_back(l);
+    }
+    ASSERT_EQ(lines.size(), 8u);
+    {
+        SCOPED_TRACE("a dump that ends before the capture does");
+        std::ofstream(dump / "INDEX.txt", std::ios::trunc) << lines[0] << "\n"
+                                                           << lines[1] << "\n"
+                                                           << lines[2] << "\n";
+        ExpectRecordFails(dir.path(), dump, "the recording ended after 3 depth frames");
+    }
+    {
+        SCOPED_TRACE("a truncated frame");
+        fs::copy_file(dump / lines[5], dir / "whole.pgm");
+        fs::resize_file(dump / lines[5], 1000);
+        std::ofstream out(dump / "INDEX.txt", std::ios::trunc);
+        for (const auto& l : lines) out << l << "\n";
+        out.close();
+        ExpectRecordFails(dir.path(), dump, "truncated");
+        fs::copy_file(dir / "whole.pgm", dump / lines[5], fs::copy_options::overwrite_existing);
+    }
+    {
+        SCOPED_TRACE("a missing frame file");
+        fs::rename(dump / lines[6], dir / "away.pgm");
+        ExpectRecordFails(dir.path(), dump, lines[6] + " is missing");
+        fs::rename(dir / "away.pgm", dump / lines[6]);
+    }
+    {
+        SCOPED_TRACE("no INDEX.txt");
+        fs::rename(dump / "INDEX.txt", dir / "INDEX.away");
+        ExpectRecordFails(dir.path(), dump, "no INDEX.txt");
+        fs::rename(dir / "INDEX.away", dump / "INDEX.txt");
+    }
+    {
+        SCOPED_TRACE("fakenect without FAKENECT_PATH");
+        ExpectRecordFails(dir.path(), "", "FAKENECT_PATH names no dump folder");
+    }
+    // Whole again, the same dump records.
+    const fs::path config = KinectConfig(dir.path(), 4, 2, 0);
+    const auto ok = RunOnFakenect(
+        dump, {"record", "--config", config.string(), "--out", (dir / "out").string()});
+    EXPECT_EQ(ok.exit_code, 0) << ok.err;
+}
+
+}  // namespace
+}  // namespace boxd
