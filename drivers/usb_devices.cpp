@@ -62,6 +62,18 @@ std::string PortPath(libusb_device* dev) {
     return path;
 }
 
+// The device's serial number string (what camera.freenect.serial names), or "" when it has
+// none or the device cannot be opened (no access: the udev rule's plugdev group).
+std::string SerialNumber(libusb_device* dev, std::uint8_t index) {
+    if (index == 0) return "";
+    libusb_device_handle* handle = nullptr;
+    if (libusb_open(dev, &handle) != 0) return "";
+    unsigned char text[128] = {};
+    const int n = libusb_get_string_descriptor_ascii(handle, index, text, sizeof(text));
+    libusb_close(handle);
+    return n > 0 ? std::string(reinterpret_cast<char*>(text), static_cast<std::size_t>(n)) : "";
+}
+
 }  // namespace
 
 const std::vector<KnownDepthCamera>& KnownDepthCameras() {
@@ -70,19 +82,19 @@ const std::vector<KnownDepthCamera>& KnownDepthCameras() {
     // (0x1d27); the ASUS vendor id 0x0b05 is not listed because it also covers keyboards and
     // mainboards. The Kinect v1 exposes motor, audio and camera devices; only the camera counts.
     static const std::vector<KnownDepthCamera> kCameras = {
-        {0x1d27, std::nullopt, "PrimeSense / ASUS Xtion"},
-        {0x045e, 0x02ae, "Microsoft Kinect v1 (Xbox 360) camera"},
-        {0x045e, 0x02bf, "Microsoft Kinect for Windows camera"},
-        {0x2bc5, std::nullopt, "Orbbec"},
+        {0x1d27, std::nullopt, "PrimeSense / ASUS Xtion", "openni2"},
+        {0x045e, 0x02ae, "Microsoft Kinect v1 (Xbox 360) camera", "freenect"},
+        {0x045e, 0x02bf, "Microsoft Kinect for Windows camera", "freenect"},
+        {0x2bc5, std::nullopt, "Orbbec", "openni2"},
     };
     return kCameras;
 }
 
-std::optional<std::string> DepthCameraName(std::uint16_t vendor_id, std::uint16_t product_id) {
+std::optional<KnownDepthCamera> FindDepthCamera(std::uint16_t vendor_id, std::uint16_t product_id) {
     for (const auto& known : KnownDepthCameras()) {
         if (known.vendor_id != vendor_id) continue;
         if (known.product_id && *known.product_id != product_id) continue;
-        return known.name;
+        return known;
     }
     return std::nullopt;
 }
@@ -105,12 +117,16 @@ Result<std::vector<UsbDeviceInfo>> ListUsbDevices(bool all) {
     for (std::size_t i = 0; i < list.size(); ++i) {
         libusb_device_descriptor desc{};
         if (libusb_get_device_descriptor(list[i], &desc) != 0) continue;
-        const auto name = DepthCameraName(desc.idVendor, desc.idProduct);
-        if (!name && !all) continue;
+        const auto known = FindDepthCamera(desc.idVendor, desc.idProduct);
+        if (!known && !all) continue;
         UsbDeviceInfo info;
         info.vendor_id = desc.idVendor;
         info.product_id = desc.idProduct;
-        info.name = name.value_or("");
+        if (known) {
+            info.name = known->name;
+            info.driver = known->driver;
+            info.serial = SerialNumber(list[i], desc.iSerialNumber);
+        }
         info.bus = libusb_get_bus_number(list[i]);
         info.address = libusb_get_device_address(list[i]);
         info.port_path = PortPath(list[i]);
@@ -142,7 +158,7 @@ Status ResetUsbDevice(const std::optional<UsbAddress>& address) {
         }
         libusb_device_descriptor desc{};
         if (libusb_get_device_descriptor(list[i], &desc) == 0 &&
-            DepthCameraName(desc.idVendor, desc.idProduct)) {
+            FindDepthCamera(desc.idVendor, desc.idProduct)) {
             target = list[i];
         }
     }

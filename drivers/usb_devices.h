@@ -16,20 +16,24 @@ struct KnownDepthCamera {
     std::uint16_t vendor_id = 0;
     std::optional<std::uint16_t> product_id;  // empty: every product of the vendor
     std::string name;
+    std::string driver;  // the camera.driver that drives it: openni2 or freenect
 };
 
 // Returns the table of known depth cameras: PrimeSense (also ASUS Xtion, which ships with the
-// PrimeSense vendor id), Microsoft Kinect v1 camera interfaces, Orbbec.
+// PrimeSense vendor id) and Orbbec through OpenNI2, the Microsoft Kinect v1 camera interfaces
+// through libfreenect (Debian's OpenNI2 has no Kinect driver).
 const std::vector<KnownDepthCamera>& KnownDepthCameras();
 
-// Returns the name of the known camera with these ids, or nothing when it is not one.
-std::optional<std::string> DepthCameraName(std::uint16_t vendor_id, std::uint16_t product_id);
+// Returns the known camera with these ids, or nothing when it is not one.
+std::optional<KnownDepthCamera> FindDepthCamera(std::uint16_t vendor_id, std::uint16_t product_id);
 
 // One attached USB device.
 struct UsbDeviceInfo {
     std::uint16_t vendor_id = 0;
     std::uint16_t product_id = 0;
     std::string name;       // known camera name, or "" for other devices
+    std::string driver;     // the camera.driver for it, or "" for other devices
+    std::string serial;     // its serial number string, or "" when it has none or no access
     int bus = 0;            // bus number
     int address = 0;        // device address on the bus (changes on re-enumeration)
     std::string port_path;  // "<bus>-<port>.<port>...", stable while the cable stays put

@@ -1,5 +1,5 @@
 # The Debian package (`cpack -G DEB` in the build folder): the binary (stripped, hardened), its
-# man page, the systemd unit, the config (a conffile) and its templates, the operator page, the
+# man page, the systemd unit, the udev rule for the cameras, the config (a conffile) and its templates, the operator page, the
 # documentation with its copyright and changelog; the maintainer scripts in systemd/deb/ add the
 # `boxd` system user the unit runs as and register the unit with deb-systemd-helper. Lintian
 # accepts it (tests/daemon/cli/package_test.cpp runs it).
@@ -25,6 +25,8 @@ set(BOXD_PACKAGE_MAINTAINER "${maintainer_default}" CACHE STRING
     "the Debian package's Maintainer: Name <address>")
 
 install(FILES systemd/boxd.service DESTINATION lib/systemd/system)
+# USB access for the `boxd` user (plugdev) to the depth cameras and the Kinect's motor.
+install(FILES systemd/60-boxd-depth-cameras.rules DESTINATION lib/udev/rules.d)
 # Shipped 0644 as Debian policy 10.9 asks; postinst makes it root:boxd 0640 (it may come to hold
 # the API's bearer token and the MQTT password).
 install(FILES config/boxd.yaml DESTINATION /etc/boxd)

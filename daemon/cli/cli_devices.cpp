@@ -1,4 +1,5 @@
-// `boxd devices`: lists the depth cameras attached over USB (libusb), as a table or JSON lines.
+// `boxd devices`: lists the depth cameras attached over USB (libusb) with the camera.driver for
+// each and its serial number, as a table or JSON lines.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -24,6 +25,8 @@ int RunDevices(const DevicesOptions& options) {
             const nlohmann::json line = {{"vendor_id", UsbIdString(d.vendor_id, 0).substr(0, 4)},
                                          {"product_id", UsbIdString(d.product_id, 0).substr(0, 4)},
                                          {"name", d.name},
+                                         {"driver", d.driver},
+                                         {"serial", d.serial},
                                          {"bus", d.bus},
                                          {"address", d.address},
                                          {"port_path", d.port_path}};
@@ -39,10 +42,13 @@ int RunDevices(const DevicesOptions& options) {
         std::printf("%s\n", options.all ? "no USB devices found" : "no depth cameras found");
         return kExitOk;
     }
-    std::printf("%-9s  %-3s  %-4s  %-12s  %s\n", "ID", "BUS", "ADDR", "PORT", "NAME");
+    std::printf("%-9s  %-3s  %-4s  %-12s  %-8s  %-18s  %s\n", "ID", "BUS", "ADDR", "PORT", "DRIVER",
+                "SERIAL", "NAME");
+    const auto or_dash = [](const std::string& s) { return s.empty() ? "-" : s.c_str(); };
     for (const UsbDeviceInfo& d : *devices) {
-        std::printf("%-9s  %03d  %04d  %-12s  %s\n", UsbIdString(d.vendor_id, d.product_id).c_str(),
-                    d.bus, d.address, d.port_path.c_str(), d.name.empty() ? "-" : d.name.c_str());
+        std::printf("%-9s  %03d  %04d  %-12s  %-8s  %-18s  %s\n",
+                    UsbIdString(d.vendor_id, d.product_id).c_str(), d.bus, d.address,
+                    d.port_path.c_str(), or_dash(d.driver), or_dash(d.serial), or_dash(d.name));
     }
     return kExitOk;
 }

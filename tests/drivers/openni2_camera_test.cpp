@@ -152,12 +152,18 @@ TEST(OpenNi2Camera, RecordingOfTheDummyDeviceReadsBack) {
 }
 
 TEST(UsbDevices, KnownDepthCameraIds) {
-    EXPECT_TRUE(DepthCameraName(0x045e, 0x02ae).has_value());   // Kinect v1 camera
-    EXPECT_FALSE(DepthCameraName(0x045e, 0x02b0).has_value());  // Kinect v1 motor
-    EXPECT_FALSE(DepthCameraName(0x045e, 0x0040).has_value());  // a Microsoft mouse
-    EXPECT_TRUE(DepthCameraName(0x1d27, 0x0601).has_value());   // Xtion Pro Live
-    EXPECT_TRUE(DepthCameraName(0x2bc5, 0x0401).has_value());   // Orbbec Astra
-    EXPECT_FALSE(DepthCameraName(0x0b05, 0x1234).has_value());  // ASUS, not a camera
+    // Each with the camera.driver that drives it: Debian's OpenNI2 has no Kinect driver.
+    const auto driver = [](std::uint16_t vendor, std::uint16_t product) {
+        const auto known = FindDepthCamera(vendor, product);
+        return known ? known->driver : std::string("none");
+    };
+    EXPECT_EQ(driver(0x045e, 0x02ae), "freenect");  // Kinect v1 camera
+    EXPECT_EQ(driver(0x045e, 0x02bf), "freenect");  // Kinect for Windows camera
+    EXPECT_EQ(driver(0x045e, 0x02b0), "none");      // Kinect v1 motor
+    EXPECT_EQ(driver(0x045e, 0x0040), "none");      // a Microsoft mouse
+    EXPECT_EQ(driver(0x1d27, 0x0601), "openni2");   // Xtion Pro Live
+    EXPECT_EQ(driver(0x2bc5, 0x0401), "openni2");   // Orbbec Astra
+    EXPECT_EQ(driver(0x0b05, 0x1234), "none");      // ASUS, not a camera
     EXPECT_EQ(UsbIdString(0x045e, 0x02ae), "045e:02ae");
 }
 

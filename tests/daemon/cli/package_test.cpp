@@ -35,8 +35,9 @@ void CheckControl(const fs::path& deb) {
     EXPECT_EQ(Field(deb, "Version"), BOXD_TEST_VERSION);
     EXPECT_EQ(Field(deb, "Architecture"), "amd64");
     const std::string depends = Field(deb, "Depends");
-    for (const char* lib : {"adduser", "libmodbus5", "libmosquitto1", "libopenni2-0",
-                            "libusb-1.0-0", "libsystemd0", "libsqlite3-0", "libjs-three"}) {
+    for (const char* lib :
+         {"adduser", "libmodbus5", "libmosquitto1", "libopenni2-0", "libfreenect0.5",
+          "libusb-1.0-0", "libsystemd0", "libsqlite3-0", "libjs-three"}) {
         EXPECT_NE(depends.find(lib), std::string::npos) << lib << " not in: " << depends;
     }
 }
@@ -50,6 +51,7 @@ void CheckContents(const fs::path& deb, const fs::path& root) {
     } expected[] = {
         {"./usr/bin/boxd", "-rwxr-xr-x"},
         {"./usr/lib/systemd/system/boxd.service", "-rw-r--r--"},
+        {"./usr/lib/udev/rules.d/60-boxd-depth-cameras.rules", "-rw-r--r--"},
         {"./etc/boxd/boxd.yaml", "-rw-r--r--"},  // postinst makes it 0640 (below)
         {"./usr/share/boxd/config/boxd.yaml", "-rw-r--r--"},
         {"./usr/share/boxd/config/sim.yaml", "-rw-r--r--"},
