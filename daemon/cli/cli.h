@@ -33,6 +33,7 @@ void AddDevices(CLI::App& app, Runner& run);
 void AddBenchMeasure(CLI::App& app, Runner& run);
 void AddVerify(CLI::App& app, Runner& run);
 void AddExport(CLI::App& app, Runner& run);
+void AddImportDump(CLI::App& app, Runner& run);
 
 // Returns "boxd 0.1.0 (commit b3d8619a2f4c, Release build)".
 std::string VersionText();

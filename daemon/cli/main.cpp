@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
     AddBenchMeasure(app, run);
     AddVerify(app, run);
     AddExport(app, run);
+    AddImportDump(app, run);
     if (argc < 2) {
         // A bare `boxd`: how to use it, on stderr with the exit code of bad usage.
         std::fprintf(stderr, "%s", app.help().c_str());

@@ -8,6 +8,7 @@
 
 #include <fstream>
 
+#include "drivers/dump_import.h"
 #include "drivers/freenect_camera.h"
 #include "drivers/station_config.h"
 #include "pipeline/core/kinect_disparity.h"
@@ -162,6 +163,32 @@ TEST(KinectDepth, IntrinsicsFromTheZeroPlane) {
     EXPECT_EQ(k.cy, 240.0);
     EXPECT_EQ(k.width, 640);
     EXPECT_NEAR(KinectIntrinsics(118.0, 0.1042).fx, 566.219, 0.001);
+}
+
+// The share of pixels whose disparity moved by more than the given steps, among those read in
+// both frames; too few read in both cannot be compared and count as moved.
+TEST(DumpImport, ChangedFractionCountsPixelsReadInBoth) {
+    std::vector<std::uint16_t> a(4000, 700), b(4000, 700);
+    for (int i = 0; i < 1000; ++i) b[i] = 703;                  // moved 3 steps
+    for (int i = 1000; i < 2000; ++i) b[i] = 702;               // moved 2: noise at levels = 2
+    for (int i = 2000; i < 2500; ++i) b[i] = kKinectNoReading;  // not read in b
+    EXPECT_DOUBLE_EQ(ChangedFraction(a, b, 2), 1000.0 / 3500.0);
+    EXPECT_DOUBLE_EQ(ChangedFraction(a, b, 1), 2000.0 / 3500.0);
+    EXPECT_DOUBLE_EQ(ChangedFraction(a, a, 0), 0.0);
+    std::vector<std::uint16_t> dark(4000, kKinectNoReading);
+    EXPECT_DOUBLE_EQ(ChangedFraction(a, dark, 2), 1.0);
+
+    DumpImportOptions o;
+    EXPECT_FALSE(o.Validate().ok());  // neither poses nor angles
+    o.poses = 4;
+    ASSERT_TRUE(o.Validate().ok());
+    EXPECT_EQ(o.Angles(), (std::vector<double>{0.0, 90.0, 180.0, 270.0}));
+    o.angles_deg = {0.0, 45.0};
+    EXPECT_FALSE(o.Validate().ok());  // both
+    o.poses = 0;
+    EXPECT_EQ(o.Angles(), (std::vector<double>{0.0, 45.0}));
+    o.frames_per_pose = 0;
+    EXPECT_NE(o.Validate().error().message.find("--frames"), std::string::npos);
 }
 
 TEST(FreenectConfig, KeysAreReadAndBadValuesNamed) {

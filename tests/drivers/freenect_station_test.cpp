@@ -185,5 +185,58 @@ TEST(FreenectStation, BrokenDumpsGiveCameraError) {
     EXPECT_EQ(ok.exit_code, 0) << ok.err;
 }
 
+// A dump recorded the way a person with a Kinect records one: fakenect-record running while the
+// table turns from stop to stop (frames of the turns between). boxd import-dump finds the stops
+// in the depth and the session measures the box.
+TEST(FreenectStation, ImportDumpFindsTheStopsAndTheSessionMeasuresTheBox) {
+    test::TempDir dir;
+    test::KinectDumpPlan plan;
+    plan.angles_deg = Angles(12, "sequential");
+    plan.frames_per_angle = 7;
+    plan.motion_frames = 9;  // 30 degrees in 10 frames: a table at 90 degrees a second
+    ASSERT_TRUE(test::WriteSimulatedKinectDump(dir / "dump", SimStation(), plan).ok());
+    const fs::path config = KinectConfig(dir.path(), 12, 3, 0);
+
+    const auto imported = test::RunBoxd({"import-dump", "--dump", (dir / "dump").string(),
+                                         "--config", config.string(), "--poses", "12", "--frames",
+                                         "5", "--out", (dir / "session").string()});
+    ASSERT_EQ(imported.exit_code, 0) << imported.err;
+    const json summary = json::parse(imported.out);
+    EXPECT_EQ(summary["poses"], 12);
+    EXPECT_EQ(summary["depth_frames"], 12 * 7 + 11 * 9);
+    // Each stop found where it was recorded: 7 still frames after 9 turning ones.
+    ASSERT_EQ(summary["still_frames"].size(), 12u);
+    for (int k = 0; k < 12; ++k) {
+        EXPECT_EQ(summary["still_frames"][k][0].get<int>(), 16 * k) << k;
+        EXPECT_EQ(summary["still_frames"][k][1].get<int>(), 16 * k + 6) << k;
+    }
+    const auto m = test::RunBoxd({"measure", "--session", (dir / "session").string()});
+    ASSERT_EQ(m.exit_code, 0) << m.err;
+    const json j = json::parse(m.out);
+    const SyntheticBox box = SimStation().box;
+    EXPECT_NEAR(j["dimensions"]["length_m"].get<double>(), box.length_m, 0.002) << j.dump();
+    EXPECT_NEAR(j["dimensions"]["width_m"].get<double>(), box.width_m, 0.002);
+    EXPECT_NEAR(j["dimensions"]["height_m"].get<double>(), box.height_m, 0.002);
+
+    // Told another count of stops, it refuses, listing what it found; nothing is written.
+    const auto wrong =
+        test::RunBoxd({"import-dump", "--dump", (dir / "dump").string(), "--config",
+                       config.string(), "--poses", "18", "--out", (dir / "wrong").string()});
+    EXPECT_EQ(wrong.exit_code, 2) << wrong.err;
+    EXPECT_NE(wrong.err.find("12 still stretches of at least 5 frames (frames 0-6, 16-22"),
+              std::string::npos)
+        << wrong.err;
+    EXPECT_NE(wrong.err.find("but 18 table stops were given"), std::string::npos) << wrong.err;
+    EXPECT_FALSE(fs::exists(dir / "wrong"));
+    // A broken dump is a CAMERA_ERROR naming what is wrong, as for the driver.
+    fs::remove(dir / "dump" / "INDEX.txt");
+    const auto broken =
+        test::RunBoxd({"import-dump", "--dump", (dir / "dump").string(), "--config",
+                       config.string(), "--poses", "12", "--out", (dir / "broken").string()});
+    EXPECT_EQ(broken.exit_code, 1) << broken.err;
+    EXPECT_NE(broken.err.find("CAMERA_ERROR"), std::string::npos) << broken.err;
+    EXPECT_NE(broken.err.find("no INDEX.txt"), std::string::npos) << broken.err;
+}
+
 }  // namespace
 }  // namespace boxd

@@ -78,7 +78,7 @@ TEST(CliUsage, AnUnknownOptionIsNamedBeforeAnyMissingOne) {
 
 TEST(CliUsage, TheHelpPointsAtShippedDocumentation) {
     for (const char* command : {"serve", "measure", "calibrate", "record", "synth", "sim-turntable",
-                                "devices", "bench-measure"}) {
+                                "devices", "bench-measure", "import-dump"}) {
         const auto r = RunBoxd({command, "--help"});
         EXPECT_EQ(r.exit_code, 0) << command;
         EXPECT_EQ(r.out.find("SPEC"), std::string::npos) << command << ": " << r.out;

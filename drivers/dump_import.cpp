@@ -1,0 +1,163 @@
+#include "drivers/dump_import.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "drivers/freenect_dump.h"
+#include "pipeline/core/kinect_disparity.h"
+
+namespace boxd {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+Error OptionError(const std::string& what) { return Error{ErrorCode::kInvalidInput, what}; }
+
+// Fewer pixels read in both frames than this: the frames cannot be compared (a covered lens).
+constexpr int kMinCommonReadings = 1000;
+
+// The depth frames of the dump, in order.
+std::vector<fs::path> DepthFiles(const DumpIndex& index) {
+    std::vector<fs::path> files;
+    for (const DumpRecord& r : index.records) {
+        if (r.type == 'd') files.push_back(index.dir / r.file);
+    }
+    return files;
+}
+
+// The share of changed pixels between consecutive frames, reading one frame at a time.
+Result<std::vector<double>> ConsecutiveChanges(const std::vector<fs::path>& files, int levels) {
+    std::vector<double> changes;
+    std::vector<std::uint16_t> previous;
+    for (const fs::path& file : files) {
+        auto raw = ReadDumpDepth(file);
+        if (!raw) return raw.error();
+        if (!previous.empty()) changes.push_back(ChangedFraction(previous, *raw, levels));
+        previous = std::move(*raw);
+    }
+    return changes;
+}
+
+// Splits the frames into still stretches against each stretch's first frame.
+Result<std::vector<StillStretch>> FindStretches(const std::vector<fs::path>& files, int levels,
+                                                double threshold) {
+    std::vector<StillStretch> stretches;
+    std::vector<std::uint16_t> reference;
+    for (std::size_t i = 0; i < files.size(); ++i) {
+        auto raw = ReadDumpDepth(files[i]);
+        if (!raw) return raw.error();
+        if (reference.empty() || ChangedFraction(reference, *raw, levels) > threshold) {
+            stretches.push_back({static_cast<int>(i), 0});
+            reference = std::move(*raw);
+        }
+        ++stretches.back().count;
+    }
+    return stretches;
+}
+
+std::string Describe(const std::vector<StillStretch>& stretches, int min_count) {
+    std::ostringstream out;
+    int listed = 0;
+    for (const StillStretch& s : stretches) {
+        if (s.count < min_count) continue;
+        out << (listed++ ? ", " : "frames ") << s.first << "-" << s.first + s.count - 1;
+    }
+    return listed ? out.str() : "none";
+}
+
+}  // namespace
+
+Status DumpImportOptions::Validate() const {
+    if (poses < 0 || poses > 360) return OptionError("--poses: must be 1..360");
+    if ((poses == 0) == angles_deg.empty()) {
+        return OptionError("give the table's stops: --poses N (evenly spaced) or --angles A,B,...");
+    }
+    if (angles_deg.size() > 360) return OptionError("--angles: at most 360");
+    for (double a : angles_deg) {
+        if (!std::isfinite(a)) return OptionError("--angles: must be numbers");
+    }
+    if (frames_per_pose < 1 || frames_per_pose > 64) return OptionError("--frames: must be 1..64");
+    if (motion_levels < 0 || motion_levels > 100) return OptionError("motion levels: 0..100");
+    if (!(motion_factor >= 1.0 && motion_factor <= 100.0)) {
+        return OptionError("motion factor: must be 1..100");
+    }
+    return OkStatus();
+}
+
+std::vector<double> DumpImportOptions::Angles() const {
+    if (!angles_deg.empty()) return angles_deg;
+    std::vector<double> angles;
+    for (int i = 0; i < poses; ++i) angles.push_back(360.0 * i / poses);
+    return angles;
+}
+
+double ChangedFraction(const std::vector<std::uint16_t>& a, const std::vector<std::uint16_t>& b,
+                       int levels) {
+    long common = 0, changed = 0;
+    const std::size_t n = std::min(a.size(), b.size());
+    for (std::size_t i = 0; i < n; ++i) {
+        if (a[i] > kKinectMaxRawDisparity || b[i] > kKinectMaxRawDisparity) continue;
+        ++common;
+        if (std::abs(int{a[i]} - int{b[i]}) > levels) ++changed;
+    }
+    if (common < kMinCommonReadings) return 1.0;
+    return static_cast<double>(changed) / static_cast<double>(common);
+}
+
+Result<DumpImport> ImportDump(const fs::path& dir, const DumpImportOptions& options,
+                              const DumpStation& station) {
+    if (auto st = options.Validate(); !st) return st.error();
+    auto index = CheckDump(dir);
+    if (!index) return index.error();
+    const std::vector<fs::path> files = DepthFiles(*index);
+    auto changes = ConsecutiveChanges(files, options.motion_levels);
+    if (!changes) return changes.error();
+    DumpImport out;
+    if (!changes->empty()) {
+        auto tenth = changes->begin() + static_cast<std::ptrdiff_t>(changes->size() / 10);
+        std::nth_element(changes->begin(), tenth, changes->end());
+        out.noise_floor = *tenth;
+    }
+    // At least a few hundred pixels of a frame must change (a noise-free recording's floor is 0).
+    out.threshold = std::max(options.motion_factor * out.noise_floor, 0.002);
+    auto stretches = FindStretches(files, options.motion_levels, out.threshold);
+    if (!stretches) return stretches.error();
+    const std::vector<double> angles = options.Angles();
+    std::vector<StillStretch> poses;
+    for (const StillStretch& s : *stretches) {
+        if (s.count >= options.frames_per_pose) poses.push_back(s);
+    }
+    if (poses.size() != angles.size()) {
+        return OptionError(dir.string() + ": " + std::to_string(poses.size()) +
+                           " still stretches of at least " +
+                           std::to_string(options.frames_per_pose) + " frames (" +
+                           Describe(*stretches, options.frames_per_pose) + ") but " +
+                           std::to_string(angles.size()) + " table stops were given");
+    }
+    out.stretches = std::move(*stretches);
+    out.depth_frames = static_cast<int>(files.size());
+    Session& session = out.session;
+    session.source = "freenect";
+    session.camera = station.camera;
+    session.calibration = station.calibration;
+    session.direction = station.direction;
+    for (std::size_t k = 0; k < poses.size(); ++k) {
+        SessionPose pose;
+        pose.angle_deg = angles[k];
+        const int first = poses[k].first + (poses[k].count - options.frames_per_pose) / 2;
+        for (int f = first; f < first + options.frames_per_pose; ++f) {
+            auto raw = ReadDumpDepth(files[static_cast<std::size_t>(f)]);
+            if (!raw) return raw.error();
+            DepthImage image(kKinectDepthWidth, kKinectDepthHeight);
+            image.pixels = RawDisparityToDepth(*raw, station.camera.depth_unit_m);
+            pose.frames.push_back(std::move(image));
+        }
+        session.poses.push_back(std::move(pose));
+    }
+    return out;
+}
+
+}  // namespace boxd
