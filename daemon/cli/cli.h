@@ -1,6 +1,7 @@
 #pragma once
 // The boxd command line: one subcommand per file (cli_<name>.cpp), registered by main.cpp.
 
+#include <filesystem>
 #include <functional>
 #include <optional>
 #include <string>
@@ -46,6 +47,10 @@ std::optional<Error> CheckArguments(const CLI::App& app, int argc, char** argv);
 // Prints "boxd: error: CODE: message" as one line on stderr and returns ExitCodeOf(error.code):
 // the one way a subcommand ends on an error.
 int Fail(const Error& error);
+
+// Returns Ok when `out` may receive a session: absent, an empty folder, or anything with `force`;
+// else INVALID_INPUT naming it.
+Status CheckOutFolder(const std::filesystem::path& out, bool force);
 
 // Routes logs to stderr; the level comes from BOXD_LOG_LEVEL (trace..critical, default info).
 void SetupLogging();

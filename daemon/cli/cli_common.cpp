@@ -19,6 +19,17 @@ int Fail(const Error& error) {
     return ExitCodeOf(error.code);
 }
 
+Status CheckOutFolder(const std::filesystem::path& out, bool force) {
+    std::error_code ec;
+    if (force || !std::filesystem::exists(out, ec) ||
+        (std::filesystem::is_directory(out, ec) && std::filesystem::is_empty(out, ec))) {
+        return OkStatus();
+    }
+    return Error{ErrorCode::kInvalidInput,
+                 "--out " + out.string() +
+                     ": exists and is not an empty folder (use --force to write into it)"};
+}
+
 void SetupLogging() {
     auto logger = spdlog::stderr_color_mt("boxd");
     spdlog::set_default_logger(logger);

@@ -50,14 +50,7 @@ Result<DumpStation> StationOf(const fs::path& path) {
 int RunImport(const ImportOptions& o) {
     auto station = StationOf(o.config);
     if (!station) return Fail(station.error());
-    std::error_code ec;
-    if (fs::exists(o.out, ec) && !o.force &&
-        !(fs::is_directory(o.out, ec) && fs::is_empty(o.out, ec))) {
-        return Fail(
-            Error{ErrorCode::kInvalidInput,
-                  "--out " + o.out.string() +
-                      ": exists and is not an empty folder (use --force to write into it)"});
-    }
+    if (auto st = CheckOutFolder(o.out, o.force); !st) return Fail(st.error());
     auto imported = ImportDump(o.dump, o.import, *station);
     if (!imported) return Fail(imported.error());
     if (auto st = WriteSession(imported->session, o.out); !st) return Fail(st.error());

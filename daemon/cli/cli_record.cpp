@@ -37,14 +37,7 @@ void OnRecordStopSignal(int) { g_cancel.store(true); }
 int RunRecord(const RecordOptions& options) {
     auto config = LoadStationConfig(options.config);
     if (!config) return Fail(config.error());
-    std::error_code ec;
-    if (fs::exists(options.out, ec) && !options.force &&
-        !(fs::is_directory(options.out, ec) && fs::is_empty(options.out, ec))) {
-        return Fail(
-            Error{ErrorCode::kInvalidInput,
-                  "--out " + options.out.string() +
-                      ": exists and is not an empty folder (use --force to write into it)"});
-    }
+    if (auto st = CheckOutFolder(options.out, options.force); !st) return Fail(st.error());
 
     auto devices = OpenStation(*config);
     if (!devices) return Fail(devices.error());

@@ -90,8 +90,7 @@ AngleSource AngleOf(Turntable& table) {
 // station calibration its scene records.
 struct Rig {
     explicit Rig(double speed_dps = 720.0)
-        : table(Connect(sim.port(), speed_dps)),
-          camera(SmallCamera(), [this]() -> Result<double> {
+        : table(Connect(sim.port(), speed_dps)), camera(SmallCamera(), [this]() -> Result<double> {
               if (!table) return Error{ErrorCode::kTurntableError, "no table"};
               return table->CurrentAngleDeg();
           }) {
@@ -303,16 +302,15 @@ TEST(CaptureConfig, ValidateNamesTheField) {
     c = CaptureConfig{};
     c.target_uncertainty_m = -0.001;
     ASSERT_FALSE(c.Validate());
-    EXPECT_NE(c.Validate().error().message.find("capture.target_uncertainty_m"),
-              std::string::npos);
+    EXPECT_NE(c.Validate().error().message.find("capture.target_uncertainty_m"), std::string::npos);
 }
 
 TEST(CaptureConfig, CoverageOrderSurroundsTheObjectFirstThenComesBack) {
     CaptureConfig c;
     c.poses = 18;
     ASSERT_EQ(c.order, "coverage");
-    EXPECT_EQ(c.Angles(), (std::vector<double>{0, 60, 120, 180, 240, 300, 340, 320, 280, 260,
-                                               220, 200, 160, 140, 100, 80, 40, 20}));
+    EXPECT_EQ(c.Angles(), (std::vector<double>{0, 60, 120, 180, 240, 300, 340, 320, 280, 260, 220,
+                                               200, 160, 140, 100, 80, 40, 20}));
     c.poses = 36;  // every 6th first: still 60 degrees apart
     const std::vector<double> a36 = c.Angles();
     ASSERT_EQ(a36.size(), 36u);

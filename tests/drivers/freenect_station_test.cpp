@@ -43,7 +43,8 @@ fs::path KinectConfig(const fs::path& dir, int poses, int frames, int drop) {
     YAML::Emitter out;
     out << root;
     const fs::path path = dir / "kinect.yaml";
-    std::ofstream(path) << out.c_str() << "\n" << test::CalibrationYaml(SimStation());
+    std::ofstream(path) << out.c_str() << "\n"
+                        << test::CalibrationYaml(test::AsKinect(SimStation()));
     return path;
 }
 
@@ -54,6 +55,17 @@ test::CommandOutput RunOnFakenect(const fs::path& dump, const std::vector<std::s
     argv.push_back(BOXD_BINARY);
     argv.insert(argv.end(), args.begin(), args.end());
     return test::RunCommand(argv);
+}
+
+// `boxd measure` of the session gives the simulated box within `tolerance_m`.
+void ExpectMeasuresTheBox(const fs::path& session, double tolerance_m) {
+    const auto m = test::RunBoxd({"measure", "--session", session.string()});
+    ASSERT_EQ(m.exit_code, 0) << m.err;
+    const json j = json::parse(m.out);
+    const SyntheticBox box = SimStation().box;
+    EXPECT_NEAR(j["dimensions"]["length_m"].get<double>(), box.length_m, tolerance_m) << j.dump();
+    EXPECT_NEAR(j["dimensions"]["width_m"].get<double>(), box.width_m, tolerance_m);
+    EXPECT_NEAR(j["dimensions"]["height_m"].get<double>(), box.height_m, tolerance_m);
 }
 
 std::vector<double> Angles(int poses, const std::string& order) {
@@ -82,13 +94,7 @@ TEST(FreenectStation, RecordReplaysTheDumpAndTheSessionMeasuresTheBox) {
     ASSERT_EQ(session->poses.size(), 12u);
     EXPECT_EQ(session->poses[0].frames.size(), 2u);
 
-    const auto m = test::RunBoxd({"measure", "--session", (dir / "session").string()});
-    ASSERT_EQ(m.exit_code, 0) << m.err;
-    const json j = json::parse(m.out);
-    const SyntheticBox box = SimStation().box;
-    EXPECT_NEAR(j["dimensions"]["length_m"].get<double>(), box.length_m, 0.002) << j.dump();
-    EXPECT_NEAR(j["dimensions"]["width_m"].get<double>(), box.width_m, 0.002);
-    EXPECT_NEAR(j["dimensions"]["height_m"].get<double>(), box.height_m, 0.002);
+    ExpectMeasuresTheBox(dir / "session", 0.002);
 }
 
 TEST(FreenectStation, ServeMeasuresTheSimulatedBoxOverHttp) {
@@ -210,13 +216,7 @@ TEST(FreenectStation, ImportDumpFindsTheStopsAndTheSessionMeasuresTheBox) {
         EXPECT_EQ(summary["still_frames"][k][0].get<int>(), 16 * k) << k;
         EXPECT_EQ(summary["still_frames"][k][1].get<int>(), 16 * k + 6) << k;
     }
-    const auto m = test::RunBoxd({"measure", "--session", (dir / "session").string()});
-    ASSERT_EQ(m.exit_code, 0) << m.err;
-    const json j = json::parse(m.out);
-    const SyntheticBox box = SimStation().box;
-    EXPECT_NEAR(j["dimensions"]["length_m"].get<double>(), box.length_m, 0.002) << j.dump();
-    EXPECT_NEAR(j["dimensions"]["width_m"].get<double>(), box.width_m, 0.002);
-    EXPECT_NEAR(j["dimensions"]["height_m"].get<double>(), box.height_m, 0.002);
+    ExpectMeasuresTheBox(dir / "session", 0.002);
 
     // Told another count of stops, it refuses, listing what it found; nothing is written.
     const auto wrong =

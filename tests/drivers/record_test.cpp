@@ -18,6 +18,7 @@
 #include "pipeline/io/session_io.h"
 #include "tests/support/child_process.h"
 #include "tests/support/run_command.h"
+#include "tests/support/simulated_kinect.h"
 #include "tests/support/temp_dir.h"
 
 namespace boxd {
@@ -126,15 +127,7 @@ fs::path CalibratedStationYaml(const fs::path& dir, int port) {
     std::ofstream(path) << StationYaml(port);
     auto config = LoadStationConfig(path);
     if (!config.ok()) return {};
-    const StationCalibration c =
-        MakeSyntheticScene(config->camera.simulated.station).recorded_calibration;
-    std::ofstream out(path, std::ios::app);
-    out.precision(9);
-    out << "calibration:\n  table_center_m: [" << c.table_center_m.x() << ", "
-        << c.table_center_m.y() << ", " << c.table_center_m.z() << "]\n  table_axis: ["
-        << c.table_axis.x() << ", " << c.table_axis.y() << ", " << c.table_axis.z()
-        << "]\n  depth_offset_m: " << c.depth_offset_m << "\n  depth_scale: " << c.depth_scale
-        << "\n";
+    std::ofstream(path, std::ios::app) << test::CalibrationYaml(config->camera.simulated.station);
     return path;
 }
 

@@ -79,7 +79,7 @@ Result<int> WriteSimulatedKinectDump(const std::filesystem::path& dir,
 }
 
 std::string CalibrationYaml(const SyntheticStationConfig& station) {
-    const StationCalibration c = MakeSyntheticScene(AsKinect(station)).recorded_calibration;
+    const StationCalibration c = MakeSyntheticScene(station).recorded_calibration;
     std::ostringstream out;
     out.precision(9);
     out << "calibration:\n  table_center_m: [" << c.table_center_m.x() << ", "

@@ -32,7 +32,8 @@ Result<int> WriteSimulatedKinectDump(const std::filesystem::path& dir,
                                      const SyntheticStationConfig& station,
                                      const KinectDumpPlan& plan);
 
-// The `calibration:` section of a station config for `station` (its recorded calibration).
+// The `calibration:` section of a station config for `station` (the recorded calibration of
+// its scene); AsKinect(station) for a Kinect station.
 std::string CalibrationYaml(const SyntheticStationConfig& station);
 
 // The environment that makes boxd replay `dump` through Debian's fakenect library.
