@@ -26,10 +26,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-Error ConfigError(const std::string& field, const std::string& what) {
-    return Error{ErrorCode::kInvalidInput, "camera.freenect." + field + ": " + what};
-}
-
 // Whether the libfreenect this process runs on is fakenect, Debian's replay library (it sits in
 // the library folder's fakenect/ and is chosen with LD_LIBRARY_PATH).
 bool RunningOnFakenect() {
@@ -82,33 +78,6 @@ std::optional<CameraIntrinsics> DeviceIntrinsics(freenect_device* dev) {
 }
 
 }  // namespace
-
-CameraIntrinsics KinectIntrinsics(double reference_distance_mm, double reference_pixel_size_mm) {
-    CameraIntrinsics k;
-    k.width = kKinectDepthWidth;
-    k.height = kKinectDepthHeight;
-    k.fx = k.fy = reference_distance_mm / (2.0 * reference_pixel_size_mm);
-    k.cx = kKinectDepthWidth / 2.0;
-    k.cy = kKinectDepthHeight / 2.0;
-    return k;
-}
-
-Status FreenectCameraConfig::Validate() const {
-    if (index < 0 || index > 15) return ConfigError("index", "must be 0..15");
-    if (depth_format != "auto" && depth_format != "mm" && depth_format != "11bit") {
-        return ConfigError("depth_format", "must be auto, mm or 11bit, got '" + depth_format + "'");
-    }
-    if (tilt_deg && !(*tilt_deg >= -27.0 && *tilt_deg <= 27.0)) {
-        return ConfigError("tilt_deg", "must be -27..27 (the motor's range)");
-    }
-    if (recover_attempts < 0 || recover_attempts > 10) {
-        return ConfigError("recover_attempts", "must be 0..10");
-    }
-    if (reopen_delay_ms < 0 || reopen_delay_ms > 60'000) {
-        return ConfigError("reopen_delay_ms", "must be 0..60000");
-    }
-    return OkStatus();
-}
 
 struct FreenectCamera::Impl {
     FreenectCameraConfig config;
@@ -178,13 +147,18 @@ Status FreenectCamera::Impl::OpenDevice() {
                            ": no Kinect found (`boxd devices` lists the USB cameras; "
                            "is the Kinect's power supply plugged in?)");
     }
+    if (config.serial.empty() && config.index >= count) {
+        return CameraError(Where() + ": there is no Kinect #" + std::to_string(config.index) +
+                           " (" + std::to_string(count) + " attached; the first is #0)");
+    }
     const int rc = config.serial.empty()
-                       ? (config.index < count ? freenect_open_device(ctx, &dev, config.index) : -1)
+                       ? freenect_open_device(ctx, &dev, config.index)
                        : freenect_open_device_by_camera_serial(ctx, &dev, config.serial.c_str());
     if (rc < 0 || !dev) {
         dev = nullptr;
-        return CameraError(Where() + ": cannot open the device (" + std::to_string(count) +
-                           " Kinect(s) attached; the boxd user needs the plugdev group)");
+        return CameraError(Where() +
+                           ": cannot open the device (is another program using it? "
+                           "the boxd user needs the plugdev group)");
     }
     auto mode = ChooseMode();
     if (!mode) return mode.error();

@@ -184,6 +184,21 @@ TEST(FreenectStation, BrokenDumpsGiveCameraError) {
         SCOPED_TRACE("fakenect without FAKENECT_PATH");
         ExpectRecordFails(dir.path(), "", "FAKENECT_PATH names no dump folder");
     }
+    {
+        SCOPED_TRACE("a Kinect that is not attached");
+        const fs::path config = KinectConfig(dir.path(), 4, 2, 0);
+        YAML::Node root = YAML::LoadFile(config.string());
+        root["camera"]["freenect"]["index"] = 3;
+        YAML::Emitter out;
+        out << root;
+        std::ofstream(dir / "third.yaml") << out.c_str() << "\n";
+        const auto r = RunOnFakenect(dump, {"record", "--config", (dir / "third.yaml").string(),
+                                            "--out", (dir / "out").string()});
+        EXPECT_EQ(r.exit_code, 1) << r.err;
+        EXPECT_NE(r.err.find("there is no Kinect #3 (1 attached; the first is #0)"),
+                  std::string::npos)
+            << r.err;
+    }
     // Whole again, the same dump records.
     const fs::path config = KinectConfig(dir.path(), 4, 2, 0);
     const auto ok = RunOnFakenect(
