@@ -199,6 +199,15 @@ TEST(FreenectStation, BrokenDumpsGiveCameraError) {
                   std::string::npos)
             << r.err;
     }
+    {
+        SCOPED_TRACE("the real libfreenect on a machine without a Kinect");
+        const auto r = test::RunCommand({"timeout", "60", BOXD_BINARY, "record", "--config",
+                                         KinectConfig(dir.path(), 4, 2, 0).string(), "--out",
+                                         (dir / "out").string()});
+        EXPECT_EQ(r.exit_code, 1) << r.err;
+        // No Kinect, or no USB at all in a container: either way the camera's error.
+        EXPECT_NE(r.err.find("CAMERA_ERROR: freenect #0: "), std::string::npos) << r.err;
+    }
     // Whole again, the same dump records.
     const fs::path config = KinectConfig(dir.path(), 4, 2, 0);
     const auto ok = RunOnFakenect(
