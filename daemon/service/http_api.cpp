@@ -202,6 +202,7 @@ void AddStatusRoutes(RouteTable& routes, const ApiContext& api) {
                    context.uptime_s = UptimeSeconds();
                    if (api.mqtt_stats) context.mqtt = api.mqtt_stats();
                    if (api.audit_status) context.audit = api.audit_status();
+                   context.camera_tilt = station->Devices().camera.tilt;
                    res.status = 200;
                    res.set_content(api.service.metrics().Text(context),
                                    "text/plain; version=0.0.4; charset=utf-8");

@@ -176,6 +176,12 @@ std::string ServiceMetrics::Text(const MetricsContext& context) const {
            static_cast<double>(camera_faults_));
     Sample(out, "boxd_device_faults_total", "device=\"scale\"", static_cast<double>(scale_faults_));
 
+    if (context.camera_tilt) {
+        Header(out, "boxd_camera_tilt_degrees", "gauge",
+               "The camera's attitude from its accelerometer: a knocked camera changes it.");
+        Sample(out, "boxd_camera_tilt_degrees", "axis=\"pitch\"", context.camera_tilt->tilt_deg);
+        Sample(out, "boxd_camera_tilt_degrees", "axis=\"roll\"", context.camera_tilt->roll_deg);
+    }
     Header(out, "boxd_calibrated", "gauge", "1 when a station calibration is in force.");
     Sample(out, "boxd_calibrated", "", context.calibrated ? 1 : 0);
     if (context.calibration_age_s) {

@@ -11,6 +11,7 @@
 #include <string>
 
 #include "daemon/service/audit_trail.h"
+#include "drivers/depth_camera.h"
 #include "pipeline/core/error_code.h"
 #include "pipeline/io/measurement.h"
 
@@ -42,8 +43,9 @@ struct MetricsContext {
     std::optional<long long> calibration_age_s;  // nullopt: no calibration, or its age unknown
     bool calibrated = false;
     long long uptime_s = 0;
-    std::optional<MqttStats> mqtt;     // with an mqtt: section
-    std::optional<AuditStatus> audit;  // the daemon's audit trail
+    std::optional<MqttStats> mqtt;          // with an mqtt: section
+    std::optional<AuditStatus> audit;       // the daemon's audit trail
+    std::optional<CameraTilt> camera_tilt;  // a camera with an accelerometer (a Kinect)
 };
 
 class ServiceMetrics {

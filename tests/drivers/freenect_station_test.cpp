@@ -11,6 +11,7 @@
 #include "drivers/freenect_dump.h"
 #include "drivers/station_config.h"
 #include "pipeline/io/session_io.h"
+#include "tests/support/prometheus_text.h"
 #include "tests/support/run_command.h"
 #include "tests/support/serve_daemon.h"
 #include "tests/support/simulated_kinect.h"
@@ -125,6 +126,11 @@ TEST(FreenectStation, ServeMeasuresTheSimulatedBoxOverHttp) {
     ASSERT_TRUE(status["devices"]["camera"].contains("tilt_deg")) << status.dump();
     EXPECT_NEAR(status["devices"]["camera"]["tilt_deg"].get<double>(), 30.0, 0.2);
     EXPECT_NEAR(status["devices"]["camera"]["roll_deg"].get<double>(), 0.0, 0.2);
+    auto metrics = daemon.client().Get("/metrics");
+    ASSERT_TRUE(metrics);
+    const auto samples = test::ParsePrometheus(metrics->body);
+    ASSERT_TRUE(samples.count("boxd_camera_tilt_degrees{axis=\"pitch\"}")) << metrics->body;
+    EXPECT_NEAR(samples.at("boxd_camera_tilt_degrees{axis=\"pitch\"}"), 30.0, 0.2);
 }
 
 // `boxd record` against a broken dump: exit 1 with CAMERA_ERROR saying what is wrong.
