@@ -5,14 +5,16 @@
 //
 // The dump does not say where the table stood: the poses are found in the depth itself. A pixel
 // changed between two frames when its raw disparity moved by more than `motion_levels` steps.
-// Between two frames of a still scene that happens only to the noisiest pixels, the same share
-// from frame to frame; a turning parcel changes far more (its outline and its faces move). The
-// dump's own noise floor is the 10th percentile of the share over its consecutive frames (the
-// quietest pairs are still ones: a recording rests longer at its stops than it turns between
-// them), and a frame belongs to the still stretch it is in while it differs from the stretch's
-// first frame by at most `motion_factor` times that floor. Each stretch of at least
-// `frames_per_pose` frames is one pose; its middle frames are kept. The table's angles come from
-// the user: `poses` evenly spaced stops over a turn, or the `angles_deg` of the stops.
+// Between two frames of a still scene that happens only to the noisiest pixels, about the same
+// share from frame to frame; a turning parcel changes far more (its outline and its faces move).
+// The dump's noise floor is that share between its quietest consecutive frames: the stops given
+// hold at least stops x (frames_per_pose - 1) still pairs, and the floor is the percentile at half
+// their share. A frame belongs to the still stretch it is in while it differs from the stretch's
+// first frame by at most `motion_factor` times the floor. Each stretch of at least
+// `frames_per_pose` frames is one pose, and its middle frames are kept. The table's angles come
+// from the user: `poses` evenly spaced stops over a turn, or the `angles_deg` of the stops; the
+// frames before the first stop or after the last (the parcel put down, the table going home) are
+// left out with `first_frame` and `last_frame`.
 
 #include <filesystem>
 #include <string>
@@ -29,6 +31,8 @@ struct DumpImportOptions {
     int poses = 0;                   // evenly spaced stops over 360 degrees, or 0 with angles_deg
     std::vector<double> angles_deg;  // the stops' table angles in recording order
     int frames_per_pose = 5;         // frames kept per pose (the stretch's middle ones)
+    int first_frame = 0;             // the dump's depth frames used: first_frame..last_frame
+    int last_frame = -1;             // (0-based; -1: to the end)
     int motion_levels = 2;           // a pixel changed: its disparity moved by more steps
     double motion_factor = 3.0;      // a frame moved: this many times the noise floor changed
 

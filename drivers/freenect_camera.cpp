@@ -3,6 +3,7 @@
 #include <dlfcn.h>
 #include <libfreenect.h>
 #include <libfreenect_registration.h>
+#include <libusb.h>
 #include <spdlog/spdlog.h>
 #include <sys/time.h>
 
@@ -113,11 +114,12 @@ struct FreenectCamera::Impl {
     }
 
     Status OpenOnce();
-    Status OpenDevice();
+    Status StartContext();
+    Status OpenDevice(int subdevices);
     Result<freenect_frame_mode> ChooseMode() const;
     void CloseDevice();
     Result<DepthImage> ReadOne(std::chrono::milliseconds timeout);
-    DepthImage Convert() const;
+    DepthImage Convert(const std::vector<std::uint16_t>& values) const;
     void ReadTilt();
     void ShowLight();
 };
@@ -140,7 +142,18 @@ Result<freenect_frame_mode> FreenectCamera::Impl::ChooseMode() const {
     return *raw;
 }
 
-Status FreenectCamera::Impl::OpenDevice() {
+Status FreenectCamera::Impl::StartContext() {
+    if (freenect_init(&ctx, nullptr) < 0) {
+        ctx = nullptr;
+        return CameraError(Where() + ": libfreenect cannot start (libusb)");
+    }
+    freenect_set_log_level(ctx, FREENECT_LOG_WARNING);
+    freenect_set_log_callback(ctx, &LogFromLibrary);
+    return OkStatus();
+}
+
+Status FreenectCamera::Impl::OpenDevice(int subdevices) {
+    freenect_select_subdevices(ctx, static_cast<freenect_device_flags>(subdevices));
     const int count = freenect_num_devices(ctx);
     if (count <= 0) {
         return CameraError(Where() +
@@ -190,17 +203,21 @@ Status FreenectCamera::Impl::OpenOnce() {
         if (auto index = CheckDump(dump); !index) return index.error();
     }
     std::lock_guard lock(mutex);
-    if (freenect_init(&ctx, nullptr) < 0) {
-        ctx = nullptr;
-        return CameraError(Where() + ": libfreenect cannot start (libusb)");
+    // The motor device carries the accelerometer, the LED and the tilt: asked for always, and
+    // left out when the device will not open with it (not every Kinect model's motor is one
+    // this libfreenect drives).
+    Status st = StartContext();
+    if (st) st = OpenDevice(FREENECT_DEVICE_CAMERA | FREENECT_DEVICE_MOTOR);
+    if (!st && ctx && !replay) {
+        const std::string with_motor = st.error().message;
+        CloseDevice();
+        st = StartContext();
+        if (st) st = OpenDevice(FREENECT_DEVICE_CAMERA);
+        if (st)
+            spdlog::warn("{}; opened without its motor: no LED, tilt nor accelerometer",
+                         with_motor);
     }
-    freenect_set_log_level(ctx, FREENECT_LOG_WARNING);
-    freenect_set_log_callback(ctx, &LogFromLibrary);
-    const bool motor = config.tilt_deg.has_value() || config.led;
-    freenect_select_subdevices(
-        ctx, static_cast<freenect_device_flags>(FREENECT_DEVICE_CAMERA |
-                                                (motor ? FREENECT_DEVICE_MOTOR : 0)));
-    if (auto st = OpenDevice(); !st) {
+    if (!st) {
         CloseDevice();
         return st;
     }
@@ -228,24 +245,28 @@ void FreenectCamera::Impl::CloseDevice() {
     open = false;
 }
 
-DepthImage FreenectCamera::Impl::Convert() const {
+DepthImage FreenectCamera::Impl::Convert(const std::vector<std::uint16_t>& values) const {
     DepthImage image(kKinectDepthWidth, kKinectDepthHeight);
     if (format == FREENECT_DEPTH_MM) {
         const double scale = 0.001 / depth_unit_m;
-        for (std::size_t i = 0; i < frame.size(); ++i) {
-            const double v = std::round(frame[i] * scale);
+        for (std::size_t i = 0; i < values.size(); ++i) {
+            const double v = std::round(values[i] * scale);
             image.pixels[i] = v <= 65535.0 ? static_cast<std::uint16_t>(v) : 0;
         }
     } else {
-        image.pixels = RawDisparityToDepth(frame, depth_unit_m);
+        image.pixels = RawDisparityToDepth(values, depth_unit_m);
     }
     return image;
 }
 
 Result<DepthImage> FreenectCamera::Impl::ReadOne(std::chrono::milliseconds timeout) {
     const Clock::time_point deadline = Clock::now() + timeout;
-    fresh = false;
-    while (!fresh) {
+    std::vector<std::uint16_t> got;
+    {
+        std::lock_guard lock(mutex);
+        fresh = false;
+    }
+    while (got.empty()) {
         const auto left =
             std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now());
         if (left.count() <= 0) {
@@ -255,19 +276,25 @@ Result<DepthImage> FreenectCamera::Impl::ReadOne(std::chrono::milliseconds timeo
         timeval tv{0, static_cast<suseconds_t>(std::min<long long>(left.count(), 100'000))};
         int rc = 0;
         {
+            // The depth callback runs inside whichever libfreenect call handles USB events:
+            // the frame is taken under the same lock.
             std::lock_guard lock(mutex);
+            if (!ctx) return CameraError(Where() + ": camera is not open");
             rc = freenect_process_events_timeout(ctx, &tv);
+            if (fresh) got.swap(frame);
         }
+        if (rc == LIBUSB_ERROR_INTERRUPTED) continue;  // a signal, not the device
         if (rc < 0 && replay) {
             return CameraError(Where() + ": the recording ended after " + std::to_string(frames) +
                                " depth frames");
         }
-        if (rc < 0)
-            return CameraError(Where() + ": the USB link failed (libfreenect " +
-                               std::to_string(rc) + ")");
+        if (rc < 0) {
+            return CameraError(Where() + ": the USB link failed (libusb " + std::to_string(rc) +
+                               ")");
+        }
     }
     ++frames;
-    return Convert();
+    return Convert(got);
 }
 
 void FreenectCamera::Impl::ReadTilt() {
@@ -289,8 +316,9 @@ void FreenectCamera::Impl::ReadTilt() {
 }
 
 void FreenectCamera::Impl::ShowLight() {
+    if (!dev || !config.led) return;  // a closed camera shows it once open
     const int pending = light.exchange(-1);
-    if (pending < 0 || !dev || !config.led) return;
+    if (pending < 0) return;
     freenect_set_led(dev, LedOf(static_cast<StationLight>(pending)));
 }
 
@@ -355,17 +383,16 @@ void FreenectCamera::Close() {
 std::string FreenectCamera::Describe() const { return impl_->Where(); }
 
 std::optional<CameraTilt> FreenectCamera::Tilt() {
-    // Fresh from the device between measurements; during one, the last frame's reading.
-    std::unique_lock lock(impl_->mutex, std::try_to_lock);
-    if (lock.owns_lock()) impl_->ReadTilt();
-    std::lock_guard tilt_lock(impl_->tilt_mutex);
+    // Read with every frame and at Open (a USB transfer of its own, never on a status page's
+    // thread): between measurements, the last one's reading.
+    std::lock_guard lock(impl_->tilt_mutex);
     return impl_->tilt;
 }
 
 void FreenectCamera::Indicate(StationLight light) {
     impl_->light = static_cast<int>(light);
-    std::unique_lock lock(impl_->mutex, std::try_to_lock);
-    if (lock.owns_lock()) impl_->ShowLight();  // else the next Grab shows it
+    std::lock_guard lock(impl_->mutex);
+    impl_->ShowLight();  // kept for Open when the camera is closed
 }
 
 }  // namespace boxd

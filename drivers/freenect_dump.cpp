@@ -52,15 +52,22 @@ Result<std::string> ReadBytes(const fs::path& path) {
     return bytes.str();
 }
 
-// Checks one record's file the way fakenect will use it.
+// Checks one record's file the way fakenect will use it: it reads every listed file whole (and
+// ends the process when one cannot be opened, or stops the replay when one is empty).
 Status CheckRecordFile(const fs::path& dir, const DumpRecord& r, int line) {
     const std::string where = " (INDEX.txt line " + std::to_string(line) + ")";
     std::error_code ec;
     const fs::path path = dir / r.file;
     if (!fs::is_regular_file(path, ec)) return DumpError(dir, r.file + " is missing" + where);
-    if (r.type != 'd') return OkStatus();
-    auto frame = ReadDumpDepth(path);
-    if (!frame) return DumpError(dir, frame.error().message + where);
+    if (r.type == 'd') {
+        auto frame = ReadDumpDepth(path);
+        if (!frame) return DumpError(dir, frame.error().message + where);
+        return OkStatus();
+    }
+    std::ifstream in(path, std::ios::binary);
+    if (!in || in.peek() == std::ifstream::traits_type::eof()) {
+        return DumpError(dir, r.file + " cannot be read or is empty" + where);
+    }
     return OkStatus();
 }
 
@@ -70,7 +77,9 @@ Result<std::vector<std::uint16_t>> ReadDumpDepth(const fs::path& path) {
     auto bytes = ReadBytes(path);
     if (!bytes) return bytes.error();
     const std::size_t offset = DataOffset(*bytes);
-    if (offset == std::string::npos || bytes->compare(0, 2, "P5") != 0) {
+    // fakenect finds the header's end with strchr: a NUL before it hides it.
+    if (offset == std::string::npos || bytes->compare(0, 2, "P5") != 0 ||
+        bytes->find('\0') < offset) {
         return CameraError(path.filename().string() + " has no PGM header line");
     }
     const std::size_t data = bytes->size() - offset;
@@ -135,13 +144,13 @@ Result<DumpWriter> DumpWriter::Create(const fs::path& dir) {
 }
 
 Status DumpWriter::Append(const DumpRecord& record, const std::string& bytes) {
-    {
-        std::ofstream out(dir_ / record.file, std::ios::binary | std::ios::trunc);
-        out << bytes;
-        if (!out) return DumpError(dir_, "cannot write " + record.file);
-    }
+    std::ofstream out(dir_ / record.file, std::ios::binary | std::ios::trunc);
+    out << bytes;
+    out.close();  // a write that fails on closing (a full disk) is not listed
+    if (!out) return DumpError(dir_, "cannot write " + record.file);
     std::ofstream index(dir_ / "INDEX.txt", std::ios::binary | std::ios::app);
     index << record.file << '\n';
+    index.close();
     if (!index) return DumpError(dir_, "cannot append to INDEX.txt");
     return OkStatus();
 }

@@ -23,8 +23,9 @@ inline constexpr int kKinectDepthWidth = 640;
 inline constexpr int kKinectDepthHeight = 480;
 inline constexpr std::size_t kKinectDepthBytes = 640 * 480 * 2;
 // The longest pause between two records a replay may hold: fakenect sleeps through recorded
-// pauses, and a Kinect streams 30 frames a second, so a longer one is not one recording.
-inline constexpr double kDumpMaxPauseS = 60.0;
+// pauses (holding the camera meanwhile), and a Kinect streams 30 frames a second, so a pause of
+// 60 frames is not one continuous recording.
+inline constexpr double kDumpMaxPauseS = 2.0;
 
 // One INDEX.txt line.
 struct DumpRecord {
@@ -42,9 +43,10 @@ struct DumpIndex {
 };
 
 // Reads `dir`'s INDEX.txt and checks what fakenect would stumble over: every listed file present
-// and readable, names it can parse, depth frames whole (header line and 614 400 bytes), records
-// in time order without a pause over kDumpMaxPauseS, at least one depth frame, no empty line
-// before the end (fakenect stops at one). CAMERA_ERROR "fakenect dump <dir>: <what>, <where>".
+// and readable and not empty, names it can parse, depth frames whole (a header line without a
+// NUL, then 614 400 bytes), records in time order without a pause over kDumpMaxPauseS, at least
+// one depth frame, no empty line before the end (fakenect stops at one). CAMERA_ERROR "fakenect
+// dump <dir>: <what>, <where>".
 Result<DumpIndex> CheckDump(const std::filesystem::path& dir);
 
 // Returns the 640 x 480 raw disparities of the depth frame file `path`; CAMERA_ERROR when it is

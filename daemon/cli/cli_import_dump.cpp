@@ -41,6 +41,11 @@ Result<DumpStation> StationOf(const fs::path& path) {
     }
     DumpStation station;
     station.camera = config->camera.intrinsics.value_or(KinectIntrinsics());
+    if (station.camera.width != 640 || station.camera.height != 480) {
+        return Error{ErrorCode::kInvalidInput,
+                     "--config " + path.string() +
+                         ": camera.intrinsics must be for the Kinect's 640 x 480 depth image"};
+    }
     station.camera.depth_unit_m = config->camera.depth_unit_m;
     station.calibration = *config->calibration;
     station.direction = ParseDirection(config->turntable.direction);
@@ -89,6 +94,9 @@ void AddImportDump(CLI::App& app, Runner& run) {
         ->delimiter(',');
     sub->add_option("--frames", o->import.frames_per_pose,
                     "frames kept from each stop, its middle ones (default 5)");
+    sub->add_option("--first", o->import.first_frame,
+                    "the first depth frame used (0-based; the frames before it are left out)");
+    sub->add_option("--last", o->import.last_frame, "the last depth frame used (default: the end)");
     sub->add_flag("--force", o->force, "Write into a folder that is not empty");
     sub->callback([&run, o] { run = [o] { return RunImport(*o); }; });
 }

@@ -130,6 +130,30 @@ TEST(FreenectDump, EachBrokenDumpIsNamed) {
         ASSERT_TRUE(writer->AddAccel(1.0, 0, 819, 0, 0).ok());
         ExpectBroken(dir.path(), "lists no depth frame");
     }
+    {
+        test::TempDir dir;
+        WriteDump(dir.path(), 2);
+        const auto lines = IndexLines(dir.path());
+        std::ofstream(dir / lines[0], std::ios::trunc);  // fakenect stops the replay at it
+        ExpectBroken(dir.path(), lines[0] + " cannot be read or is empty (INDEX.txt line 1)");
+    }
+    {
+        test::TempDir dir;
+        WriteDump(dir.path(), 2);
+        const auto lines = IndexLines(dir.path());
+        std::fstream f(dir / lines[1], std::ios::binary | std::ios::in | std::ios::out);
+        f.seekp(3);
+        f.put('\0');  // fakenect's strchr would miss the header's end
+        f.close();
+        ExpectBroken(dir.path(), "no PGM header line");
+    }
+    {
+        test::TempDir dir;
+        auto writer = DumpWriter::Create(dir.path());
+        ASSERT_TRUE(writer->AddDepth(10.0, 0, Ramp(0)).ok());
+        ASSERT_TRUE(writer->AddDepth(12.5, 1, Ramp(1)).ok());  // fakenect would sleep 2.5 s
+        ExpectBroken(dir.path(), "2.500000 s after the line before");
+    }
 }
 
 // The published conversion (N. Burrus; OpenKinect, ROS openni_camera): z = 1 / (raw x

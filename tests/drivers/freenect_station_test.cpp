@@ -228,18 +228,35 @@ TEST(FreenectStation, ImportDumpFindsTheStopsAndTheSessionMeasuresTheBox) {
     test::TempDir dir;
     test::KinectDumpPlan plan;
     plan.angles_deg = Angles(12, "sequential");
+    plan.angles_deg.push_back(360.0);  // and home again at the end, resting there
     plan.frames_per_angle = 7;
     plan.motion_frames = 9;  // 30 degrees in 10 frames: a table at 90 degrees a second
     ASSERT_TRUE(test::WriteSimulatedKinectDump(dir / "dump", SimStation(), plan).ok());
     const fs::path config = KinectConfig(dir.path(), 12, 3, 0);
+    const auto import = [&](const std::vector<std::string>& extra, const std::string& out) {
+        std::vector<std::string> args = {
+            "import-dump",   "--dump", (dir / "dump").string(), "--config",
+            config.string(), "--out",  (dir / out).string()};
+        args.insert(args.end(), extra.begin(), extra.end());
+        return test::RunBoxd(args);
+    };
 
-    const auto imported = test::RunBoxd({"import-dump", "--dump", (dir / "dump").string(),
-                                         "--config", config.string(), "--poses", "12", "--frames",
-                                         "5", "--out", (dir / "session").string()});
+    // Thirteen stops for twelve poses: it refuses, listing what it found; nothing is written.
+    const auto wrong = import({"--poses", "12"}, "wrong");
+    EXPECT_EQ(wrong.exit_code, 2) << wrong.err;
+    EXPECT_NE(wrong.err.find("13 still stretches of at least 5 frames (frames 0-6, 16-22"),
+              std::string::npos)
+        << wrong.err;
+    EXPECT_NE(wrong.err.find("192-198) but 12 table stops were given"), std::string::npos)
+        << wrong.err;
+    EXPECT_FALSE(fs::exists(dir / "wrong"));
+
+    // The last stop (home again) left out.
+    const auto imported = import({"--poses", "12", "--frames", "5", "--last", "182"}, "session");
     ASSERT_EQ(imported.exit_code, 0) << imported.err;
     const json summary = json::parse(imported.out);
     EXPECT_EQ(summary["poses"], 12);
-    EXPECT_EQ(summary["depth_frames"], 12 * 7 + 11 * 9);
+    EXPECT_EQ(summary["depth_frames"], 13 * 7 + 12 * 9);
     // Each stop found where it was recorded: 7 still frames after 9 turning ones.
     ASSERT_EQ(summary["still_frames"].size(), 12u);
     for (int k = 0; k < 12; ++k) {
@@ -247,17 +264,12 @@ TEST(FreenectStation, ImportDumpFindsTheStopsAndTheSessionMeasuresTheBox) {
         EXPECT_EQ(summary["still_frames"][k][1].get<int>(), 16 * k + 6) << k;
     }
     ExpectMeasuresTheBox(dir / "session", 0.002);
+    // Or the first stop left out and the rest given by their angles: frame numbers stay the dump's.
+    const auto later = import(
+        {"--angles", "30,60,90,120,150,180,210,240,270,300,330,360", "--first", "10"}, "later");
+    ASSERT_EQ(later.exit_code, 0) << later.err;
+    EXPECT_EQ(json::parse(later.out)["still_frames"][0][0].get<int>(), 16) << later.out;
 
-    // Told another count of stops, it refuses, listing what it found; nothing is written.
-    const auto wrong =
-        test::RunBoxd({"import-dump", "--dump", (dir / "dump").string(), "--config",
-                       config.string(), "--poses", "18", "--out", (dir / "wrong").string()});
-    EXPECT_EQ(wrong.exit_code, 2) << wrong.err;
-    EXPECT_NE(wrong.err.find("12 still stretches of at least 5 frames (frames 0-6, 16-22"),
-              std::string::npos)
-        << wrong.err;
-    EXPECT_NE(wrong.err.find("but 18 table stops were given"), std::string::npos) << wrong.err;
-    EXPECT_FALSE(fs::exists(dir / "wrong"));
     // A broken dump is a CAMERA_ERROR naming what is wrong, as for the driver.
     fs::remove(dir / "dump" / "INDEX.txt");
     const auto broken =
