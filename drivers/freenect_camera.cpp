@@ -11,12 +11,12 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <mutex>
 #include <thread>
 #include <vector>
 
 #include "drivers/freenect_dump.h"
+#include "drivers/usb_devices.h"
 
 namespace boxd {
 
@@ -353,20 +353,19 @@ Result<DepthImage> FreenectCamera::Grab(std::chrono::milliseconds timeout) {
     if (!impl_->open) return CameraError(impl_->Where() + ": camera is not open");
     auto frame = impl_->ReadOne(timeout);
     // A replay that ended does not come back by reopening; a live device may.
-    for (int attempt = 1; !frame && !impl_->replay && attempt <= impl_->config.recover_attempts;
-         ++attempt) {
+    const FreenectCameraConfig& c = impl_->config;
+    for (int attempt = 1; !frame && !impl_->replay && attempt <= c.recover_attempts; ++attempt) {
         spdlog::warn("{}; reopening the device ({} of {})", frame.error().message, attempt,
-                     impl_->config.recover_attempts);
+                     c.recover_attempts);
         {
             std::lock_guard lock(impl_->mutex);
             impl_->CloseDevice();
         }
-        std::this_thread::sleep_for(std::chrono::milliseconds(impl_->config.reopen_delay_ms));
-        if (auto st = impl_->OpenOnce(); !st) {
-            frame = st.error();
-            continue;
-        }
-        frame = impl_->ReadOne(timeout);
+        Status reset = c.usb_reset ? ResetCameraOf("freenect", c.serial, c.index) : OkStatus();
+        if (!reset) spdlog::warn("{}: {}", impl_->Where(), reset.error().message);
+        std::this_thread::sleep_for(std::chrono::milliseconds(c.reopen_delay_ms));
+        Status opened = impl_->OpenOnce();
+        frame = opened ? impl_->ReadOne(timeout) : Result<DepthImage>(opened.error());
     }
     std::lock_guard lock(impl_->mutex);
     if (frame) impl_->ReadTilt();

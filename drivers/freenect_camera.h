@@ -28,8 +28,11 @@ struct FreenectCameraConfig {
     std::optional<double> tilt_deg;     // motor angle held from Open (-27..27); none: left alone
     bool led = true;  // the LED shows the station's state (green idle, blinking green while
                       // measuring, red after a fault)
-    int recover_attempts = 2;  // closes and reopens the device this often when frames stop
-    int reopen_delay_ms = 2000;
+    // When frames stop: how many times to close, reset through libusb (when `usb_reset`) and
+    // reopen the device before Grab gives up.
+    int recover_attempts = 2;
+    bool usb_reset = true;
+    int reopen_delay_ms = 2000;  // wait after closing (and a reset) for the device to return
 
     // Returns an error naming the first invalid field ("camera.freenect.<field>: ..."), or Ok.
     Status Validate() const;

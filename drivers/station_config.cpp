@@ -152,6 +152,7 @@ Status ReadFreenect(const YAML::Node& node, const std::string& key, FreenectCame
                            {"tilt_deg", tilt_reader},
                            {"led", Value(c.led)},
                            {"recover_attempts", Value(c.recover_attempts)},
+                           {"usb_reset", Value(c.usb_reset)},
                            {"reopen_delay_ms", Value(c.reopen_delay_ms)}});
         !st) {
         return st;

@@ -180,4 +180,19 @@ Status ResetUsbDevice(const std::optional<UsbAddress>& address) {
     return OkStatus();
 }
 
+Status ResetCameraOf(const std::string& driver, const std::string& serial, int index) {
+    auto devices = ListUsbDevices();
+    if (!devices) return devices.error();
+    int seen = 0;
+    for (const UsbDeviceInfo& d : *devices) {
+        if (d.driver != driver) continue;
+        if (serial.empty() ? seen++ == index : d.serial == serial) {
+            return ResetUsbDevice(UsbAddress{d.bus, d.address});
+        }
+    }
+    std::string which = serial;
+    if (which.empty()) which.append("#").append(std::to_string(index));
+    return CameraError("usb: no " + driver + " camera " + which + " attached");
+}
+
 }  // namespace boxd

@@ -58,6 +58,11 @@ std::optional<UsbAddress> UsbAddressFromOpenNiUri(const std::string& uri);
 // device or the reset fails.
 Status ResetUsbDevice(const std::optional<UsbAddress>& address);
 
+// Resets the `index`-th attached camera that `driver` drives (in the bus's order, as libfreenect
+// counts them), or the one whose serial number is `serial` when that is set (the freenect
+// driver's recovery step). CAMERA_ERROR when there is none or the reset fails.
+Status ResetCameraOf(const std::string& driver, const std::string& serial, int index);
+
 // Returns "045e:02ae" for the ids.
 std::string UsbIdString(std::uint16_t vendor_id, std::uint16_t product_id);
 
