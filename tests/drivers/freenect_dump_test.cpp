@@ -219,13 +219,14 @@ TEST(FreenectConfig, KeysAreReadAndBadValuesNamed) {
     auto parse = [](const std::string& text) { return ParseCameraConfig(YAML::Load(text)); };
     auto good = parse(
         "driver: freenect\nfreenect: {serial: A00366A10291104A, depth_format: "
-        "11bit, tilt_deg: -10, led: false, recover_attempts: 1}\n");
+        "11bit, tilt_deg: -10, led: false, recover_attempts: 1, usb_reset: false}\n");
     ASSERT_TRUE(good.ok()) << good.error().message;
     EXPECT_EQ(good->freenect.serial, "A00366A10291104A");
     EXPECT_EQ(good->freenect.depth_format, "11bit");
     ASSERT_TRUE(good->freenect.tilt_deg.has_value());
     EXPECT_EQ(*good->freenect.tilt_deg, -10.0);
     EXPECT_FALSE(good->freenect.led);
+    EXPECT_FALSE(good->freenect.usb_reset);
     auto plain = parse("driver: freenect\n");
     ASSERT_TRUE(plain.ok());
     EXPECT_FALSE(plain->freenect.tilt_deg.has_value());
