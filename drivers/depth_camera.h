@@ -8,6 +8,8 @@
 // reading: never averaged or filtered here (that is the pipeline's job).
 
 #include <chrono>
+#include <cmath>
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -32,6 +34,13 @@ struct CameraTilt {
     double motor_deg = 0.0;  // the tilt motor's own reported angle
     double accel_mps2[3] = {0.0, 0.0, 0.0};  // the raw gravity vector, device axes
 };
+
+// Returns a depth of `units` of the frame's unit (not yet rounded) as a frame value: rounded, and
+// 0 (no reading) where the unit cannot hold it: a depth is dropped, never clamped to a wrong one.
+inline std::uint16_t DepthValue(double units) {
+    const double v = std::round(units);
+    return v > 0.0 && v <= 65535.0 ? static_cast<std::uint16_t>(v) : 0;
+}
 
 class DepthCamera {
 public:

@@ -249,10 +249,8 @@ DepthImage FreenectCamera::Impl::Convert(const std::vector<std::uint16_t>& value
     DepthImage image(kKinectDepthWidth, kKinectDepthHeight);
     if (format == FREENECT_DEPTH_MM) {
         const double scale = 0.001 / depth_unit_m;
-        for (std::size_t i = 0; i < values.size(); ++i) {
-            const double v = std::round(values[i] * scale);
-            image.pixels[i] = v <= 65535.0 ? static_cast<std::uint16_t>(v) : 0;
-        }
+        for (std::size_t i = 0; i < values.size(); ++i)
+            image.pixels[i] = DepthValue(values[i] * scale);
     } else {
         image.pixels = RawDisparityToDepth(values, depth_unit_m);
     }

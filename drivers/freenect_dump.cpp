@@ -192,9 +192,7 @@ std::vector<std::uint16_t> RawDisparityToDepth(const std::vector<std::uint16_t>&
     const KinectDepthTable& levels = KinectDisparityDepths();
     std::vector<std::uint16_t> depth(raw.size(), 0);
     for (std::size_t i = 0; i < raw.size(); ++i) {
-        if (raw[i] > kKinectMaxRawDisparity) continue;
-        const double v = std::round(levels[raw[i]] / depth_unit_m);
-        depth[i] = v > 0.0 && v <= 65535.0 ? static_cast<std::uint16_t>(v) : 0;
+        if (raw[i] <= kKinectMaxRawDisparity) depth[i] = DepthValue(levels[raw[i]] / depth_unit_m);
     }
     return depth;
 }

@@ -281,11 +281,7 @@ Result<DepthImage> OpenNi2Camera::Impl::ReadOne(std::chrono::milliseconds timeou
     DepthImage image(frame.getWidth(), frame.getHeight());
     for (int y = 0; y < image.height; ++y) {
         const auto* row = reinterpret_cast<const openni::DepthPixel*>(base + y * stride);
-        for (int x = 0; x < image.width; ++x) {
-            const double v = std::round(row[x] * scale);
-            // A depth the output unit cannot hold is dropped, never clamped to a wrong value.
-            image.at(x, y) = v <= 65535.0 ? static_cast<std::uint16_t>(v) : 0;
-        }
+        for (int x = 0; x < image.width; ++x) image.at(x, y) = DepthValue(row[x] * scale);
     }
     return image;
 }

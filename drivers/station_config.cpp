@@ -86,6 +86,17 @@ Reader Seed(std::uint64_t& target) {
     };
 }
 
+// A value that may be absent: set only where the key is given.
+template <typename T>
+Reader OptionalValue(std::optional<T>& target) {
+    return [&target](const YAML::Node& node, const std::string& key) -> Status {
+        T value{};
+        if (auto st = Value(value)(node, key); !st) return st;
+        target = value;
+        return OkStatus();
+    };
+}
+
 Reader Intrinsics(std::optional<CameraIntrinsics>& target) {
     return [&target](const YAML::Node& node, const std::string& key) -> Status {
         CameraIntrinsics k;
@@ -137,30 +148,6 @@ Status ReadSimulated(const YAML::Node& node, const std::string& key, SimulatedCa
         });
 }
 
-// The `camera.freenect:` section; `tilt_deg` may be absent (the motor is left alone).
-Status ReadFreenect(const YAML::Node& node, const std::string& key, FreenectCameraConfig& c) {
-    double tilt = 0.0;
-    bool has_tilt = false;
-    const Reader tilt_reader = [&](const YAML::Node& n, const std::string& k) {
-        has_tilt = true;
-        return Value(tilt)(n, k);
-    };
-    if (auto st = ReadMap(node, key,
-                          {{"index", Value(c.index)},
-                           {"serial", Value(c.serial)},
-                           {"depth_format", Value(c.depth_format)},
-                           {"tilt_deg", tilt_reader},
-                           {"led", Value(c.led)},
-                           {"recover_attempts", Value(c.recover_attempts)},
-                           {"usb_reset", Value(c.usb_reset)},
-                           {"reopen_delay_ms", Value(c.reopen_delay_ms)}});
-        !st) {
-        return st;
-    }
-    if (has_tilt) c.tilt_deg = tilt;
-    return OkStatus();
-}
-
 }  // namespace
 
 Status CameraConfig::Validate() const {
@@ -196,6 +183,17 @@ Result<CameraConfig> ParseCameraConfig(const YAML::Node& node) {
         {"usb_reset", Value(o.usb_reset)},
         {"reopen_delay_ms", Value(o.reopen_delay_ms)},
     };
+    FreenectCameraConfig& f = c.freenect;
+    const std::map<std::string, Reader> freenect = {
+        {"index", Value(f.index)},
+        {"serial", Value(f.serial)},
+        {"depth_format", Value(f.depth_format)},
+        {"tilt_deg", OptionalValue(f.tilt_deg)},  // absent: the motor is left alone
+        {"led", Value(f.led)},
+        {"recover_attempts", Value(f.recover_attempts)},
+        {"usb_reset", Value(f.usb_reset)},
+        {"reopen_delay_ms", Value(f.reopen_delay_ms)},
+    };
     if (auto st = ReadMap(
             node, "camera",
             {
@@ -205,7 +203,7 @@ Result<CameraConfig> ParseCameraConfig(const YAML::Node& node) {
                 {"openni2",
                  [&](const YAML::Node& n, const std::string& k) { return ReadMap(n, k, openni2); }},
                 {"freenect", [&](const YAML::Node& n,
-                                 const std::string& k) { return ReadFreenect(n, k, c.freenect); }},
+                                 const std::string& k) { return ReadMap(n, k, freenect); }},
                 {"simulated",
                  [&](const YAML::Node& n, const std::string& k) {
                      return ReadSimulated(n, k, c.simulated);

@@ -91,6 +91,7 @@ Status DeviceStation::OpenLocked() {
     const std::string turntable = opened->turntable->Describe();
     const std::string camera = opened->camera->Describe();
     const std::string scale = opened->scale ? opened->scale->Describe() : "";
+    opened->camera->Indicate(StationLight::kIdle);
     {
         std::lock_guard lock(devices_mutex_);
         turntable_description_ = turntable;
@@ -101,7 +102,6 @@ Status DeviceStation::OpenLocked() {
         open_ = true;
     }
     spdlog::info("devices up: turntable {}; camera {}", turntable, camera);
-    OpenDevices()->camera->Indicate(StationLight::kIdle);
     return OkStatus();
 }
 
