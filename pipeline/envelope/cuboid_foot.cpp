@@ -1,6 +1,8 @@
 // AddUnseenFeet: the feet of a cuboid's side faces that nothing read (cuboid_foot.h).
 #include "pipeline/envelope/cuboid_foot.h"
 
+#include <spdlog/spdlog.h>
+
 #include <array>
 #include <cmath>
 #include <vector>
@@ -8,6 +10,7 @@
 #include "pipeline/core/median.h"
 #include "pipeline/core/student_t.h"
 #include "pipeline/envelope/foot_free_space.h"
+#include "pipeline/envelope/support_envelope.h"
 
 namespace boxd::envelope {
 
@@ -29,6 +32,12 @@ struct Side {
 
 // Returns whether nothing read the lowest row of cells of `side` (from the band up) while its
 // rows above were read; false where the face is too low to tell.
+std::array<Side, 4> SidesOf(const BoxFit& fit, double lu, double lv, const Eigen::Vector2d& o) {
+    const Eigen::Vector2d a = fit.length_axis, b(-a.y(), a.x());
+    return {Side{a, b, lv / 2.0, a.dot(o) + lu / 2.0}, Side{-a, b, lv / 2.0, -a.dot(o) + lu / 2.0},
+            Side{b, a, lu / 2.0, b.dot(o) + lv / 2.0}, Side{-b, a, lu / 2.0, -b.dot(o) + lv / 2.0}};
+}
+
 bool FootUnread(const std::vector<Eigen::Vector3f>& pts, const Side& side,
                 const Eigen::Vector2d& center, double height, const EnvelopeConfig& config) {
     std::array<int, kProfileRows + 1> rows{};
@@ -54,10 +63,8 @@ bool FootUnread(const std::vector<Eigen::Vector3f>& pts, const Side& side,
 Status AddUnseenFeet(const Surface& surface, const BoxFit& fit, double lu, double lv, double sigma,
                      const EnvelopeConfig& config, EnclosingCuboid* c) {
     if (!surface.table_known) return OkStatus();
-    const Eigen::Vector2d a = fit.length_axis, b(-a.y(), a.x()), o = c->center_m;
-    const std::array<Side, 4> sides = {
-        Side{a, b, lv / 2.0, a.dot(o) + lu / 2.0}, Side{-a, b, lv / 2.0, -a.dot(o) + lu / 2.0},
-        Side{b, a, lu / 2.0, b.dot(o) + lv / 2.0}, Side{-b, a, lu / 2.0, -b.dot(o) + lv / 2.0}};
+    const Eigen::Vector2d o = c->center_m;
+    const std::array<Side, 4> sides = SidesOf(fit, lu, lv, o);
     const TableBeside table = TableBesideOf(surface, sigma, config);
     std::array<double, 4> se{};
     for (std::size_t f = 0; f < 4; ++f) {
@@ -70,6 +77,21 @@ Status AddUnseenFeet(const Surface& surface, const BoxFit& fit, double lu, doubl
     c->sigma_m[0] = std::hypot(c->sigma_m[0], lu >= lv ? extra_u : extra_v);
     c->sigma_m[1] = std::hypot(c->sigma_m[1], lu >= lv ? extra_v : extra_u);
     return OkStatus();
+}
+
+int SideLeaningOut(const Surface& surface, const BoxFit& fit, double lu, double lv,
+                   const Eigen::Vector2d& center, const std::array<double, 4>& face_se,
+                   double sigma, const EnvelopeConfig& config) {
+    const std::array<Side, 4> sides = SidesOf(fit, lu, lv, center);
+    for (std::size_t f = 0; f < 4; ++f) {
+        const FootReach foot = FootAlong(surface, sides[f].normal, sigma, config);
+        if (!std::isfinite(foot.reach)) continue;
+        const double beyond = foot.reach - sides[f].reach, se = std::hypot(foot.se, face_se[f]);
+        spdlog::debug("envelope: side {} foot {:+.2f} mm beyond its face (se {:.2f}, slope {:.3f})",
+                      f, beyond * 1e3, se * 1e3, foot.slope);
+        if (beyond > kNormal95 * se) return static_cast<int>(f);
+    }
+    return -1;
 }
 
 }  // namespace boxd::envelope

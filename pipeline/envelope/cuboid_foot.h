@@ -6,6 +6,8 @@
 // (foot_free_space.h): the table's readings beside the object bound how far, and the bound
 // reaches that; with no table reading beyond, the measurement is refused.
 
+#include <array>
+
 #include "pipeline/core/result.h"
 #include "pipeline/envelope/surface_cells.h"
 #include "pipeline/fit/box_fit.h"
@@ -20,5 +22,17 @@ namespace boxd::envelope {
 // a foot (without the table's readings, `Surface::table_known`, a foot stays where it is read).
 Status AddUnseenFeet(const Surface& surface, const BoxFit& fit, double lu, double lv, double sigma,
                      const EnvelopeConfig& config, EnclosingCuboid* c);
+
+// Returns the first side (0..3: +fit.length_axis, its opposite, the axis square to it, its
+// opposite) that leans out, or -1. The face fits place a side at its plane, fitted over its
+// height, and read it as upright; a wall that keeps sloping outward down to the table (a carton
+// tapering a few millimetres, however flat its faces) stands widest at its foot, below its
+// plane's mean height. A side leans out where its foot, extrapolated as any wall's
+// (foot_band.h: only where its lowest rows slope outward beyond their noise), stands beyond its
+// face's place by more than the 95% bound of the two: read as a cuboid's face, it would stand
+// outside its own bound. `face_se` holds each side face's standard error.
+int SideLeaningOut(const Surface& surface, const BoxFit& fit, double lu, double lv,
+                   const Eigen::Vector2d& center, const std::array<double, 4>& face_se,
+                   double sigma, const EnvelopeConfig& config);
 
 }  // namespace boxd::envelope

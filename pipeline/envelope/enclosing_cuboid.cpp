@@ -196,6 +196,14 @@ EnclosingCuboid FaceFitCuboid(const FusedCloud& cloud, const BoxFit& fit, int vi
         c.max_relative_excess <= config.max_relative_excess &&
         spread <= config.max_view_spread_rmse * std::max(in.agreement_m, in.noise_sigma_m / 4);
     LogFaces(faces, c);
+    // Flat faces at right angles, but a side that keeps sloping outward down to the table stands
+    // widest where the face fit does not read it (its planes sit at their mean height).
+    if (c.cuboid) {
+        c.cuboid =
+            envelope::SideLeaningOut(in.surface, fit, *lu, *lv, c.center_m,
+                                     {face_sigma(0), face_sigma(1), face_sigma(2), face_sigma(3)},
+                                     in.sigma, config) < 0;
+    }
     return c;
 }
 

@@ -309,6 +309,14 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double he
     return LargestBound(grid.cells, config, sigma, height_sigma, cell, se, &judged, true, true);
 }
 
+FootReach FootAlong(const Surface& surface, const Eigen::Vector2d& u, double sigma,
+                    const EnvelopeConfig& config) {
+    std::vector<Layers> layers = BuildLayers(surface.points, u, sigma, surface.radius, surface.top,
+                                             {{config.cell_along_m, config.cell_height_m}}, config);
+    MarkSlopesToReadHigh(&layers[0].front, sigma, config);
+    return ExtrapolateFoot(layers[0].front, config);
+}
+
 Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, double height_sigma,
                                        const EnvelopeConfig& config) {
     const std::vector<Eigen::Vector3f>& pts = surface.points;

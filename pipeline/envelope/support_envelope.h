@@ -9,6 +9,7 @@
 
 #include "pipeline/core/result.h"
 #include "pipeline/envelope/enclosing_cuboid.h"
+#include "pipeline/envelope/foot_band.h"
 #include "pipeline/envelope/surface_cells.h"
 #include "pipeline/fit/fusion.h"
 
@@ -19,6 +20,11 @@ namespace boxd::envelope {
 // readings spread up a wall's end (HeightNoiseSigma where no view saw a top).
 double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double height_sigma,
                 double radius, const EnvelopeConfig& config, double* se);
+
+// The foot of the surface's outer layer in direction `u` (a unit vector in the table's plane),
+// read from the cells SupportAlong reads it from (foot_band.h).
+FootReach FootAlong(const Surface& surface, const Eigen::Vector2d& u, double sigma,
+                    const EnvelopeConfig& config);
 
 // The least-area footprint rectangle of the support function, and the height (`sigma` and
 // `height_sigma` as for TopBound).

@@ -1,10 +1,13 @@
-// The unseen feet of a cuboid's side faces (pipeline/envelope/cuboid_foot.h): a carton whose +x
-// side reads nothing in its lowest 30 mm, where it flares out by 4 mm, with the table read from its
-// true foot outward; the same carton read down to the band; and with no table beyond.
+// The feet of a cuboid's side faces (pipeline/envelope/cuboid_foot.h): a carton whose +x side
+// reads nothing in its lowest 30 mm, where it flares out by 4 mm, with the table read from its
+// true foot outward; the same carton read down to the band; and with no table beyond. A side
+// that slopes outward all the way down (a tapered carton) leans out of its face; an upright one,
+// or one that bulges at mid-height, does not.
 #include "pipeline/envelope/cuboid_foot.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -100,6 +103,58 @@ TEST(CuboidFoot, AFootNothingReadWithNoTableBeyondIsRefused) {
     ASSERT_FALSE(st.ok());
     EXPECT_EQ(st.error().code, ErrorCode::kInsufficientData);
     EXPECT_NE(st.error().message.find("foot"), std::string::npos);
+}
+
+// A 300 x 200 x 200 carton read every 3 mm with 1 mm of noise across its sides, whose +x side
+// runs `taper` farther out at its foot than at its top, straight, or bulges out by `bulge` at
+// mid-height (a sine over its height).
+Surface Tapered(double taper, double bulge, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, 0.001);
+    Surface s = Carton(0.0, true, seed);
+    s.points.clear();
+    auto add = [&](double x, double y, double z) {
+        s.points.emplace_back(static_cast<float>(x), static_cast<float>(y), static_cast<float>(z));
+    };
+    for (double z = 0.013; z <= kHeight; z += 0.003) {
+        const double out = taper * (1.0 - z / kHeight) + bulge * std::sin(M_PI * z / kHeight);
+        for (double y = -kHalfW; y <= kHalfW; y += 0.003) {
+            add(kHalfL + out + noise(rng), y, z);
+            add(-kHalfL - noise(rng), y, z);
+        }
+        for (double x = -kHalfL; x <= kHalfL; x += 0.003) {
+            add(x, kHalfW + noise(rng), z);
+            add(x, -kHalfW - noise(rng), z);
+        }
+    }
+    for (double x = -kHalfL; x <= kHalfL; x += 0.003) {
+        for (double y = -kHalfW; y <= kHalfW; y += 0.003) add(x, y, kHeight);
+    }
+    return s;
+}
+
+// Where a face fit places the +x side: its plane at the side's mean over its height.
+int Leaning(double taper, double bulge, unsigned seed) {
+    const double mean_out = taper / 2.0 + bulge * 2.0 / M_PI;
+    const double lu = 2.0 * kHalfL + mean_out;
+    return SideLeaningOut(Tapered(taper, bulge, seed), Fit(), lu, 2.0 * kHalfW,
+                          Eigen::Vector2d(mean_out / 2.0, 0.0), {0.0003, 0.0003, 0.0003, 0.0003},
+                          0.001, EnvelopeConfig{});
+}
+
+TEST(CuboidFoot, ASideSlopingOutwardToTheTableLeansOut) {
+    for (unsigned seed = 1; seed <= 3; ++seed) {
+        // 10 mm over 200 mm: the foot stands 5 mm beyond the plane at mid-height.
+        EXPECT_EQ(Leaning(0.010, 0.0, seed), 0) << "seed " << seed;
+    }
+}
+
+TEST(CuboidFoot, UprightAndBulgingSidesDoNotLean) {
+    for (unsigned seed = 1; seed <= 5; ++seed) {
+        EXPECT_EQ(Leaning(0.0, 0.0, seed), -1) << "seed " << seed;
+        // A panel bulging 5 mm at mid-height comes back in towards its foot.
+        EXPECT_EQ(Leaning(0.0, 0.005, seed), -1) << "seed " << seed;
+    }
 }
 
 }  // namespace
