@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 
 #include "calibration/station_calibrator.h"
 #include "pipeline/io/station_calibration_json.h"
@@ -34,6 +35,7 @@ nlohmann::json ToJson(const CalibrationReport& r) {
         {"center_shift_m", r.center_shift_m},
         {"axis_change_deg", r.axis_change_deg},
         {"pose_angle_corrections_deg", r.pose_angle_corrections_deg},
+        {"edge_growth_edges", r.edge_growth_edges},
     };
     j["uncertainty"] = {
         {"table_center_m", r.uncertainty.table_center_m},
@@ -80,7 +82,14 @@ std::string CalibrationYaml(const CalibrationReport& r) {
                   c.table_center_m.x(), c.table_center_m.y(), c.table_center_m.z(),
                   c.table_axis.x(), c.table_axis.y(), c.table_axis.z(), c.depth_offset_m,
                   c.depth_scale, c.focal_scale);
-    return buf;
+    std::string yaml = buf;
+    for (const auto& [key, value] : {std::pair{"multipath_albedo", c.multipath_albedo},
+                                     std::pair{"edge_growth_px", c.edge_growth_px}}) {
+        if (!(value > 0.0)) continue;
+        std::snprintf(buf, sizeof(buf), "  %s: %.9g\n", key, value);
+        yaml += buf;
+    }
+    return yaml;
 }
 
 }  // namespace boxd

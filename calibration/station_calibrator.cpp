@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "calibration/edge_growth.h"
 #include "calibration/joint_refinement.h"
 #include "calibration/turntable_centre.h"
 #include "pipeline/fit/fuse_and_fit.h"
@@ -218,6 +219,8 @@ JointRefinementConfig JointConfigOf(const CalibrationConfig& config,
 void FillReport(const JointSolution& sol, const Session& session, const CalibrationConfig& config,
                 CalibrationReport& report) {
     report.calibration = sol.calibration;
+    // Not estimated here: a time-of-flight station's reflectance stays what it was.
+    report.calibration.multipath_albedo = session.calibration.multipath_albedo;
     report.depth_scale_estimated = config.estimate_depth_scale;
     report.focal_scale_estimated = config.estimate_focal_scale;
     report.uncertainty = {sol.sigma_center_m,       sol.sigma_height_m,    sol.sigma_axis_deg,
@@ -237,6 +240,47 @@ void FillReport(const JointSolution& sol, const Session& session, const Calibrat
     report.center_shift_m =
         (report.calibration.table_center_m - report.recorded.table_center_m).norm();
     report.axis_change_deg = AngleDeg(report.calibration.table_axis, report.recorded.table_axis);
+}
+
+// Returns the edge growth read from the reference box's outline in each pose's averaged frames
+// (edge_growth.h): the readings as the camera gave them, before the flying pixels are removed.
+EdgeGrowth LearnEdges(const Session& session, const JointSolution& sol, const BoxDimensions& ref,
+                      const CalibrationConfig& config) {
+    std::vector<DepthMap> averaged;
+    for (const SessionPose& pose : session.poses) {
+        auto d =
+            AverageDepthFrames(pose.frames, session.camera.depth_unit_m, config.measure.averaging);
+        averaged.push_back(d ? std::move(*d) : DepthMap{});
+    }
+    const EdgeGrowth growth = LearnEdgeGrowth(averaged, session.camera, sol, ref);
+    spdlog::info("calibrate: edges grow by {:.1f} px (median of {} edges of the box's outline)",
+                 growth.px, growth.edges);
+    return growth;
+}
+
+// The joint solution, and the camera's edge growth. Where the edges grow, the readings beside
+// the box at its depth pull its faces out; the problem is solved again from the first solution
+// on the depths without them, as a measurement takes them away (grown_edges.h).
+Result<JointSolution> RefineWithEdges(const Session& session, const InitialEstimate& est,
+                                      const BoxDimensions& ref, const CalibrationConfig& config,
+                                      const CalibrationProgress& progress, EdgeGrowth* growth) {
+    JointRefinementConfig jc = JointConfigOf(config, progress);
+    auto sol = RefineJointly(CollectViews(est.depths, session, est, ref, config), session.camera,
+                             ref, InitialState(est, session), jc);
+    if (!sol) return sol;
+    *growth = LearnEdges(session, *sol, ref, config);
+    StationCalibration grown = session.calibration;
+    grown.edge_growth_px = growth->px;
+    const FrameConfig frames = config.measure.Frames(grown);
+    if (frames.edge_growth_px > 0) {
+        auto depths = UsableDepths(PrepareSession(session, frames), config.measure.refusal);
+        if (!depths) return Error{ErrorCode::kTableNotVisible, depths.error().message};
+        jc.on_round = nullptr;  // a second solve from the first: its steps were told
+        sol = RefineJointly(CollectViews(*depths, session, est, ref, config), session.camera, ref,
+                            sol->state, jc);
+    }
+    if (sol) sol->calibration.edge_growth_px = growth->px;
+    return sol;
 }
 
 }  // namespace
@@ -295,10 +339,8 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
     report.reference = ref;
     report.measured_before = {est->box.length_m, est->box.width_m, est->box.height_m};
 
-    const std::vector<CalibrationView> views =
-        CollectViews(est->depths, session, *est, ref, config);
-    auto sol = RefineJointly(views, session.camera, ref, InitialState(*est, session),
-                             JointConfigOf(config, progress));
+    EdgeGrowth growth;
+    auto sol = RefineWithEdges(session, *est, ref, config, progress, &growth);
     if (!sol) return sol.error();
     const double face_rms_limit =
         std::max(config.face_rms_ratio * sol->table_rms_m, config.face_rms_floor_m);
@@ -312,6 +354,7 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
                         sol->face_rms_m * 1e3, face_rms_limit * 1e3, sol->table_rms_m * 1e3)};
     }
     FillReport(*sol, session, config, report);
+    report.edge_growth_edges = growth.edges;
     if (Status s = report.calibration.Validate(); !s) {
         return Error{ErrorCode::kNotConverged,
                      "the estimate is not a valid calibration: " + s.error().message};

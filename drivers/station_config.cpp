@@ -254,6 +254,7 @@ Result<StationCalibration> ParseCalibration(const YAML::Node& node) {
                               {"depth_scale", Value(c.depth_scale)},
                               {"focal_scale", Value(c.focal_scale)},
                               {"multipath_albedo", Value(c.multipath_albedo)},
+                              {"edge_growth_px", Value(c.edge_growth_px)},
                           });
         !st) {
         return st.error();

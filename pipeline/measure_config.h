@@ -2,7 +2,10 @@
 // MeasureConfig: the measurement's settings, one struct per stage in recipe order (the YAML
 // sections carry the same names), plus the refusal rules and the confidence figure.
 
+#include <cmath>
+
 #include "pipeline/core/result.h"
+#include "pipeline/core/station_calibration.h"
 #include "pipeline/envelope/enclosing_cuboid.h"
 #include "pipeline/fit/box_fit.h"
 #include "pipeline/fit/fusion.h"
@@ -45,7 +48,13 @@ struct MeasureConfig {
     // Returns an error naming the first invalid field, or Ok.
     Status Validate() const;
     // Returns what the first stage (PreparePose) takes of it.
-    FrameConfig Frames() const { return FrameConfig{averaging, flying_pixels, threads}; }
+    // Without an edge growth to take away (the calibration reads the edges as they come).
+    FrameConfig Frames() const { return FrameConfig{averaging, flying_pixels, threads, 0}; }
+    // `calibration`: the session's, whose camera's edge growth the stage takes away.
+    FrameConfig Frames(const StationCalibration& calibration) const {
+        return FrameConfig{averaging, flying_pixels, threads,
+                           static_cast<int>(std::lround(calibration.edge_growth_px))};
+    }
 };
 
 enum class BoxMethod { kFootprint, kPca };

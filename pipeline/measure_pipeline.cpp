@@ -245,7 +245,7 @@ Result<MeasureOutput> MeasureSession(const Session& session, const MeasureConfig
     return MeasureAfter(
         session,
         [&]() -> Result<std::vector<PreparedPose>> {
-            return PrepareSession(session, config.Frames());
+            return PrepareSession(session, config.Frames(session.calibration));
         },
         config, method, clock);
 }
@@ -254,7 +254,7 @@ Result<MeasureOutput> MeasureFromSource(const Session& header, const PoseFrameSo
                                         const MeasureConfig& config, BoxMethod method,
                                         const MonotonicMs& clock) {
     return MeasureAfter(
-        header, [&] { return PrepareFromSource(header, config.Frames(), frames); }, config, method,
+        header, [&] { return PrepareFromSource(header, config.Frames(header.calibration), frames); }, config, method,
         clock);
 }
 

@@ -261,7 +261,8 @@ void AddSensorEffectOptions(CLI::App* sub, SynthOptions& o) {
                     "A second viewpoint this far along the camera's x axis (negative: -x) must "
                     "see a point too: a projector's or a second imager's shadows (m)");
     sub->add_option("--edge-fattening-px", o.edge_fattening_px,
-                    "Nearer surfaces read this many pixels wider along x at depth edges");
+                    "Nearer surfaces read this many pixels wider along x at depth edges (the "
+                    "recorded calibration's edge_growth_px says so, as boxd calibrate learns it)");
     sub->add_option("--correlated-noise-m", o.correlated_noise_m,
                     "Smooth noise drawn every frame: sigma at 1 m (m), growing as depth^2");
     sub->add_option("--correlation-px", o.correlation_px,

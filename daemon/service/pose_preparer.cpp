@@ -46,7 +46,7 @@ void PosePreparer::Work() {
         Job job = std::move(queue_.front());
         queue_.pop_front();
         lock.unlock();
-        waiting_.emplace(job.index, PreparePose(job.frames, job.depth_unit_m, config_.Frames()));
+        waiting_.emplace(job.index, PreparePose(job.frames, job.depth_unit_m, config_.Frames(header_.calibration)));
         // The stream takes the poses in order; a pose ahead of its turn waits for the others.
         for (auto it = waiting_.find(static_cast<std::size_t>(stream_.Added()));
              it != waiting_.end(); it = waiting_.find(static_cast<std::size_t>(stream_.Added()))) {
@@ -162,10 +162,10 @@ ViewStream& PosePreparer::Finish(const Session& session) {
             rest[static_cast<std::size_t>(k)] = std::move(it->second);
         } else if (const Job* job = queued[static_cast<std::size_t>(k)]) {
             rest[static_cast<std::size_t>(k)] =
-                PreparePose(job->frames, job->depth_unit_m, config_.Frames());
+                PreparePose(job->frames, job->depth_unit_m, config_.Frames(header_.calibration));
         } else {
             rest[static_cast<std::size_t>(k)] =
-                PreparePose(session.poses[i].frames, session.camera.depth_unit_m, config_.Frames());
+                PreparePose(session.poses[i].frames, session.camera.depth_unit_m, config_.Frames(header_.calibration));
         }
     });
     waiting_.clear();

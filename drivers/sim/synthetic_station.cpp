@@ -196,6 +196,7 @@ SyntheticScene MakeSyntheticScene(const SyntheticStationConfig& config) {
     truth.depth_scale = 1.0;
     truth.focal_scale = 1.0 + config.focal_error_pct / 100.0;
     truth.multipath_albedo = scene.noise.multipath_albedo;
+    truth.edge_growth_px = scene.noise.edge_fattening_px;
     scene.true_calibration = truth;
 
     // The recorded calibration: the centre moved by the configured distance in a random

@@ -28,6 +28,9 @@ Status StationCalibration::Validate(const std::string& where) const {
     if (!std::isfinite(multipath_albedo) || multipath_albedo < 0.0 || multipath_albedo > 1.0) {
         return bad("multipath_albedo", "must be a finite number in 0..1");
     }
+    if (!std::isfinite(edge_growth_px) || edge_growth_px < 0.0 || edge_growth_px > 20.0) {
+        return bad("edge_growth_px", "must be a finite number of pixels in 0..20");
+    }
     return OkStatus();
 }
 

@@ -23,6 +23,10 @@ struct StationCalibration {
     // the station's table and parcels in the camera's light, which sets how much light reaches a
     // point by way of another surface. 0: a camera without multipath (structured light, stereo).
     double multipath_albedo = 0.0;
+    // How far a nearer surface's depth spreads past its edge along the image rows, in pixels: a
+    // structured-light or stereo camera matches a window of pixels, and a window straddling a
+    // depth edge takes the nearer surface's depth (edge fattening; grown_edges.h). 0: none.
+    double edge_growth_px = 0.0;
 
     // Returns an error naming the first invalid field (prefixed with `where`), or Ok.
     Status Validate(const std::string& where = "calibration") const;

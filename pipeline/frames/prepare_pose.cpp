@@ -14,7 +14,8 @@ PreparedPose PreparePose(const std::vector<DepthImage>& frames, double depth_uni
         out.error = avg.error().message;
         return out;
     }
-    out.depth = RemoveFlyingPixels(*avg, config.flying_pixels);
+    out.depth = RemoveFlyingPixels(
+        RemoveGrownEdges(*avg, config.edge_growth_px, config.flying_pixels), config.flying_pixels);
     return out;
 }
 

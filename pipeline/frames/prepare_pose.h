@@ -1,7 +1,8 @@
 #pragma once
-// Frames stage: one pose's frames averaged (AverageDepthFrames) and cleared of flying pixels
-// (RemoveFlyingPixels). The only stage that needs nothing but the pose's own frames, so a
-// capture runs it while the table moves on; every later stage needs all poses.
+// Frames stage: one pose's frames averaged (AverageDepthFrames), cleared of the readings a
+// nearer surface's depth spread to (RemoveGrownEdges) and of flying pixels (RemoveFlyingPixels).
+// The only stage that needs nothing but the pose's own frames, so a capture runs it while the table
+// moves on; every later stage needs all poses.
 
 #include <functional>
 #include <optional>
@@ -11,6 +12,7 @@
 #include "pipeline/core/depth_image.h"
 #include "pipeline/core/result.h"
 #include "pipeline/frames/frame_averaging.h"
+#include "pipeline/frames/grown_edges.h"
 #include "pipeline/io/session.h"
 
 namespace boxd {
@@ -20,6 +22,9 @@ struct FrameConfig {
     AveragingConfig averaging;
     FlyingPixelConfig flying_pixels;
     int threads = 2;  // poses prepared at once
+    // The camera's edge growth in whole pixels (StationCalibration::edge_growth_px), taken away
+    // before the flying pixels (grown_edges.h).
+    int edge_growth_px = 0;
 };
 
 struct PreparedPose {
