@@ -36,6 +36,7 @@ nlohmann::json ToJson(const CalibrationReport& r) {
         {"axis_change_deg", r.axis_change_deg},
         {"pose_angle_corrections_deg", r.pose_angle_corrections_deg},
         {"edge_growth_edges", r.edge_growth_edges},
+        {"depth_pattern_blocks", r.depth_pattern_blocks},
     };
     j["uncertainty"] = {
         {"table_center_m", r.uncertainty.table_center_m},
@@ -84,7 +85,8 @@ std::string CalibrationYaml(const CalibrationReport& r) {
                   c.depth_scale, c.focal_scale);
     std::string yaml = buf;
     for (const auto& [key, value] : {std::pair{"multipath_albedo", c.multipath_albedo},
-                                     std::pair{"edge_growth_px", c.edge_growth_px}}) {
+                                     std::pair{"edge_growth_px", c.edge_growth_px},
+                                     std::pair{"depth_pattern_m", c.depth_pattern_m}}) {
         if (!(value > 0.0)) continue;
         std::snprintf(buf, sizeof(buf), "  %s: %.9g\n", key, value);
         yaml += buf;

@@ -14,7 +14,6 @@
 #include "calibration/joint_refinement.h"
 #include "pipeline/core/camera.h"
 #include "pipeline/core/depth_image.h"
-#include "pipeline/io/session.h"
 
 namespace boxd {
 

@@ -6,10 +6,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "calibration/depth_pattern.h"
 #include "calibration/edge_growth.h"
 #include "calibration/joint_refinement.h"
 #include "calibration/turntable_centre.h"
 #include "pipeline/fit/fuse_and_fit.h"
+#include "pipeline/frames/multipath_correction.h"
 #include "pipeline/frames/prepare_pose.h"
 #include "pipeline/refusal.h"
 #include "pipeline/registration/register_views.h"
@@ -58,6 +60,18 @@ Error AsCalibrationRefusal(const MeasurementReason& why) {
         default:
             return Error{ErrorCode::kNoReference, "reference box: " + why.message};
     }
+}
+
+// `depths` without a time-of-flight camera's multipath, taken out as a measurement takes it
+// (multipath_correction.h) with the recorded reflectance: the joint problem fits planes, and
+// multipath stands a wall back by up to centimetres.
+std::vector<DepthMap> WithoutMultipath(std::vector<DepthMap> depths, const Session& session) {
+    if (!(session.calibration.multipath_albedo > 0.0)) return depths;
+    for (DepthMap& d : depths) {
+        if (!d.z_m.empty())
+            d = CorrectMultipath(std::move(d), session.camera, session.calibration).depth;
+    }
+    return depths;
 }
 
 // A centre the calibration knows nothing of, as a sigma: a metre, beyond any table.
@@ -121,6 +135,7 @@ Result<InitialEstimate> EstimateInitial(const Session& session, const MeasureCon
     }
     est.box = *fit.box;
     est.box.center_m -= centre->center;
+    est.depths = WithoutMultipath(std::move(est.depths), session);
     return est;
 }
 
@@ -242,44 +257,60 @@ void FillReport(const JointSolution& sol, const Session& session, const Calibrat
     report.axis_change_deg = AngleDeg(report.calibration.table_axis, report.recorded.table_axis);
 }
 
-// Returns the edge growth read from the reference box's outline in each pose's averaged frames
-// (edge_growth.h): the readings as the camera gave them, before the flying pixels are removed.
-EdgeGrowth LearnEdges(const Session& session, const JointSolution& sol, const BoxDimensions& ref,
-                      const CalibrationConfig& config) {
+// What the camera does that the joint problem's terms do not hold: its edges' growth
+// (edge_growth.h) and its fixed depth pattern (depth_pattern.h), read against the reference.
+struct CameraTraits {
+    EdgeGrowth growth;
+    DepthPattern pattern;
+};
+
+// Each pose's frames averaged: the readings as the camera gave them, before the flying pixels
+// are removed.
+std::vector<DepthMap> AveragedDepths(const Session& session, const CalibrationConfig& config) {
     std::vector<DepthMap> averaged;
     for (const SessionPose& pose : session.poses) {
         auto d =
             AverageDepthFrames(pose.frames, session.camera.depth_unit_m, config.measure.averaging);
         averaged.push_back(d ? std::move(*d) : DepthMap{});
     }
-    const EdgeGrowth growth = LearnEdgeGrowth(averaged, session.camera, sol, ref);
-    spdlog::info("calibrate: edges grow by {:.1f} px (median of {} edges of the box's outline)",
-                 growth.px, growth.edges);
-    return growth;
+    return averaged;
 }
 
-// The joint solution, and the camera's edge growth. Where the edges grow, the readings beside
-// the box at its depth pull its faces out; the problem is solved again from the first solution
-// on the depths without them, as a measurement takes them away (grown_edges.h).
-Result<JointSolution> RefineWithEdges(const Session& session, const InitialEstimate& est,
-                                      const BoxDimensions& ref, const CalibrationConfig& config,
-                                      const CalibrationProgress& progress, EdgeGrowth* growth) {
+// The joint solution, and the camera's traits. Where the edges grow, the readings beside the
+// box at its depth pull its faces out; the problem is solved again from the first solution on
+// the depths without them, as a measurement takes them away (grown_edges.h).
+Result<JointSolution> RefineWithCamera(const Session& session, const InitialEstimate& est,
+                                       const BoxDimensions& ref, const CalibrationConfig& config,
+                                       const CalibrationProgress& progress, CameraTraits* traits) {
     JointRefinementConfig jc = JointConfigOf(config, progress);
     auto sol = RefineJointly(CollectViews(est.depths, session, est, ref, config), session.camera,
                              ref, InitialState(est, session), jc);
     if (!sol) return sol;
-    *growth = LearnEdges(session, *sol, ref, config);
+    const std::vector<DepthMap> averaged =
+        WithoutMultipath(AveragedDepths(session, config), session);
+    traits->growth = LearnEdgeGrowth(averaged, session.camera, *sol, ref);
+    spdlog::info("calibrate: edges grow by {:.1f} px (median of {} edges of the box's outline)",
+                 traits->growth.px, traits->growth.edges);
     StationCalibration grown = session.calibration;
-    grown.edge_growth_px = growth->px;
+    grown.edge_growth_px = traits->growth.px;
     const FrameConfig frames = config.measure.Frames(grown);
     if (frames.edge_growth_px > 0) {
         auto depths = UsableDepths(PrepareSession(session, frames), config.measure.refusal);
         if (!depths) return Error{ErrorCode::kTableNotVisible, depths.error().message};
         jc.on_round = nullptr;  // a second solve from the first: its steps were told
-        sol = RefineJointly(CollectViews(*depths, session, est, ref, config), session.camera, ref,
-                            sol->state, jc);
+        sol = RefineJointly(
+            CollectViews(WithoutMultipath(std::move(*depths), session), session, est, ref, config),
+            session.camera, ref, sol->state, jc);
+        if (!sol) return sol;
     }
-    if (sol) sol->calibration.edge_growth_px = growth->px;
+    traits->pattern = LearnDepthPattern(averaged, session.camera, *sol, ref);
+    spdlog::info(
+        "calibrate: a fixed depth pattern of {:.2f} mm at 1 m ({} blocks, their noise "
+        "{:.2f} mm)",
+        traits->pattern.sigma_at_1m * 1e3, traits->pattern.blocks,
+        traits->pattern.noise_at_1m * 1e3);
+    sol->calibration.edge_growth_px = traits->growth.px;
+    sol->calibration.depth_pattern_m = traits->pattern.sigma_at_1m;
     return sol;
 }
 
@@ -339,8 +370,8 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
     report.reference = ref;
     report.measured_before = {est->box.length_m, est->box.width_m, est->box.height_m};
 
-    EdgeGrowth growth;
-    auto sol = RefineWithEdges(session, *est, ref, config, progress, &growth);
+    CameraTraits traits;
+    auto sol = RefineWithCamera(session, *est, ref, config, progress, &traits);
     if (!sol) return sol.error();
     const double face_rms_limit =
         std::max(config.face_rms_ratio * sol->table_rms_m, config.face_rms_floor_m);
@@ -354,7 +385,8 @@ Result<CalibrationReport> CalibrateStation(const Session& session, const BoxDime
                         sol->face_rms_m * 1e3, face_rms_limit * 1e3, sol->table_rms_m * 1e3)};
     }
     FillReport(*sol, session, config, report);
-    report.edge_growth_edges = growth.edges;
+    report.edge_growth_edges = traits.growth.edges;
+    report.depth_pattern_blocks = traits.pattern.blocks;
     if (Status s = report.calibration.Validate(); !s) {
         return Error{ErrorCode::kNotConverged,
                      "the estimate is not a valid calibration: " + s.error().message};

@@ -81,7 +81,8 @@ struct CalibrationReport {
     std::vector<double> pose_angle_corrections_deg;  // estimated turntable angle errors
     double center_shift_m = 0.0;                     // |new centre - recorded centre|
     double axis_change_deg = 0.0;
-    int edge_growth_edges = 0;  // the outline's edges the edge growth was read from
+    int edge_growth_edges = 0;     // the outline's edges the edge growth was read from
+    int depth_pattern_blocks = 0;  // the image blocks the depth pattern was read from
 };
 
 // Told of each step of a calibration as it goes: the step ("registering", "refining") and how

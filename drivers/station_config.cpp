@@ -255,6 +255,7 @@ Result<StationCalibration> ParseCalibration(const YAML::Node& node) {
                               {"focal_scale", Value(c.focal_scale)},
                               {"multipath_albedo", Value(c.multipath_albedo)},
                               {"edge_growth_px", Value(c.edge_growth_px)},
+                              {"depth_pattern_m", Value(c.depth_pattern_m)},
                           });
         !st) {
         return st.error();

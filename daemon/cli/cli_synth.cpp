@@ -268,7 +268,9 @@ void AddSensorEffectOptions(CLI::App* sub, SynthOptions& o) {
     sub->add_option("--correlation-px", o.correlation_px,
                     "Spacing of the correlated noise's knots (pixels, default 16)");
     sub->add_option("--fixed-pattern-m", o.fixed_pattern_m,
-                    "A bias pattern the same in every frame: sigma at 1 m (m), growing as depth^2");
+                    "A bias pattern the same in every frame: its knots' sigma at 1 m (m), growing "
+                    "as depth^2 (the recorded calibration's depth_pattern_m holds its spread over "
+                    "the image, as boxd calibrate learns it)");
     sub->add_option("--fixed-pattern-px", o.fixed_pattern_px,
                     "Spacing of the fixed pattern's knots (pixels, default 64)");
     sub->add_option("--multipath-albedo", o.multipath_albedo,

@@ -114,11 +114,15 @@ std::vector<float> SmoothErrors(const SyntheticScene& scene, std::uint64_t frame
     };
     add(noise.correlated_sigma_m, noise.correlation_px, rnd::Derive(frame_seed, kCorrelated));
     add(noise.fixed_pattern_m, noise.fixed_pattern_px,
-        rnd::Derive(scene.config.seed, kStreamFixedPattern));
+        SyntheticFixedPatternSeed(scene.config.seed));
     return out;
 }
 
 }  // namespace
+
+std::uint64_t SyntheticFixedPatternSeed(std::uint64_t seed) {
+    return rnd::Derive(seed, kStreamFixedPattern);
+}
 
 DepthImage RenderDepthFrame(const SyntheticScene& scene, double true_angle_rad,
                             std::uint64_t frame_seed, int pose_index) {

@@ -9,6 +9,7 @@
 #include <thread>
 #include <vector>
 
+#include "drivers/sim/sensor_effects.h"
 #include "drivers/sim/synthetic_geometry.h"
 #include "drivers/sim/synthetic_objects.h"
 #include "drivers/sim/synthetic_random.h"
@@ -183,6 +184,27 @@ BoxDimensions SyntheticGroundTruth(const SyntheticBox& box) {
     return SyntheticEnclosingCuboid(box);
 }
 
+namespace {
+
+// The standard deviation over the image, at 1 m, of the scene's fixed-pattern field: what a
+// calibration reads of it (calibration/depth_pattern.h).
+double FixedPatternSigma(const SyntheticScene& scene) {
+    if (!(scene.noise.fixed_pattern_m > 0.0)) return 0.0;
+    const std::vector<float> field = sensor_effects::SmoothField(
+        scene.config.camera.width, scene.config.camera.height, scene.noise.fixed_pattern_px,
+        SyntheticFixedPatternSeed(scene.config.seed));
+    double sum = 0.0, sum_sq = 0.0;
+    for (float f : field) {
+        sum += f;
+        sum_sq += static_cast<double>(f) * f;
+    }
+    const double n = static_cast<double>(field.size());
+    return scene.noise.fixed_pattern_m *
+           std::sqrt(std::max(0.0, sum_sq / n - (sum / n) * (sum / n)));
+}
+
+}  // namespace
+
 SyntheticScene MakeSyntheticScene(const SyntheticStationConfig& config) {
     SyntheticScene scene;
     scene.config = config;
@@ -197,6 +219,7 @@ SyntheticScene MakeSyntheticScene(const SyntheticStationConfig& config) {
     truth.focal_scale = 1.0 + config.focal_error_pct / 100.0;
     truth.multipath_albedo = scene.noise.multipath_albedo;
     truth.edge_growth_px = scene.noise.edge_fattening_px;
+    truth.depth_pattern_m = FixedPatternSigma(scene);
     scene.true_calibration = truth;
 
     // The recorded calibration: the centre moved by the configured distance in a random

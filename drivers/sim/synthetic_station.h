@@ -131,6 +131,10 @@ SyntheticScene MakeSyntheticScene(const SyntheticStationConfig& config);
 DepthImage RenderDepthFrame(const SyntheticScene& scene, double true_angle_rad,
                             std::uint64_t frame_seed, int pose_index = 0);
 
+// Returns the seed of the fixed-pattern field (SensorNoiseParams::fixed_pattern_m) of a session
+// rendered with `seed`: the same in every frame.
+std::uint64_t SyntheticFixedPatternSeed(std::uint64_t seed);
+
 // Returns the noise seed of frame `frame` of pose `pose` in a session rendered with `seed`.
 std::uint64_t SyntheticFrameSeed(std::uint64_t seed, int pose, int frame);
 

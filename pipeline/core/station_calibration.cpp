@@ -31,6 +31,9 @@ Status StationCalibration::Validate(const std::string& where) const {
     if (!std::isfinite(edge_growth_px) || edge_growth_px < 0.0 || edge_growth_px > 20.0) {
         return bad("edge_growth_px", "must be a finite number of pixels in 0..20");
     }
+    if (!std::isfinite(depth_pattern_m) || depth_pattern_m < 0.0 || depth_pattern_m > 0.05) {
+        return bad("depth_pattern_m", "must be a finite number of metres in 0..0.05");
+    }
     return OkStatus();
 }
 

@@ -27,6 +27,11 @@ struct StationCalibration {
     // structured-light or stereo camera matches a window of pixels, and a window straddling a
     // depth edge takes the nearer surface's depth (edge fattening; grown_edges.h). 0: none.
     double edge_growth_px = 0.0;
+    // The camera's fixed depth pattern: the standard deviation over the image, at 1 m (growing
+    // with the depth squared), of a per-pixel bias that is the same in every frame
+    // (calibration/depth_pattern.h). A parcel's top and the table are seen at the same pixels in
+    // every view, so the height's bound carries it. 0: none measured.
+    double depth_pattern_m = 0.0;
 
     // Returns an error naming the first invalid field (prefixed with `where`), or Ok.
     Status Validate(const std::string& where = "calibration") const;

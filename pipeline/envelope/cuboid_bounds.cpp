@@ -40,7 +40,13 @@ std::array<double, 3> CuboidBounds95(const FusedFit& fit, const EnclosingCuboid&
                             unit),
         SharedRoundingSigma(table.rounding, unit));
     spdlog::debug("uncertainty: the depths' rounding {:.3f} mm in the height", rounding * 1e3);
-    const double shared[3] = {moved[0], moved[1], std::hypot(table.center_se_m, rounding)};
+    // The camera's fixed depth pattern (StationCalibration::depth_pattern_m): the top and the
+    // table are seen at the same pixels in every view, so each keeps the bias of its pixels,
+    // which no view's scatter shows; at the table's depth, their difference's.
+    const double depth = (table.camera_to_table.inverse() * Eigen::Vector3d::Zero()).z();
+    const double pattern = std::sqrt(2.0) * calibration.depth_pattern_m * depth * depth;
+    spdlog::debug("uncertainty: the depth pattern {:.3f} mm in the height", pattern * 1e3);
+    const double shared[3] = {moved[0], moved[1], std::hypot(table.center_se_m, rounding, pattern)};
     // A time-of-flight camera's multipath correction, trusted to within its own size
     // (multipath_correction.h): a 95% bound of the walls' in the length and width, of all the
     // object's in the height.

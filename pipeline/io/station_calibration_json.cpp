@@ -53,6 +53,7 @@ json ToJson(const StationCalibration& c) {
               {"focal_scale", c.focal_scale}};
     if (c.multipath_albedo > 0.0) j["multipath_albedo"] = c.multipath_albedo;
     if (c.edge_growth_px > 0.0) j["edge_growth_px"] = c.edge_growth_px;
+    if (c.depth_pattern_m > 0.0) j["depth_pattern_m"] = c.depth_pattern_m;
     return j;
 }
 
@@ -72,7 +73,8 @@ Result<StationCalibration> StationCalibrationFromJson(const json& j, const std::
           std::tuple{"depth_scale", &c.depth_scale, false},
           std::tuple{"focal_scale", &c.focal_scale, false},
           std::tuple{"multipath_albedo", &c.multipath_albedo, false},
-          std::tuple{"edge_growth_px", &c.edge_growth_px, false}}) {
+          std::tuple{"edge_growth_px", &c.edge_growth_px, false},
+          std::tuple{"depth_pattern_m", &c.depth_pattern_m, false}}) {
         auto m = Member(j, where, key, required);
         if (!m) return m.error();
         if (*m == nullptr) continue;
