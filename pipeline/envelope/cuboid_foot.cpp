@@ -30,14 +30,16 @@ struct Side {
     double half_across = 0.0, reach = 0.0;
 };
 
-// Returns whether nothing read the lowest row of cells of `side` (from the band up) while its
-// rows above were read; false where the face is too low to tell.
+// The four side faces of the cuboid of sides `lu` along fit.length_axis and `lv` across it,
+// centred at `o`: +length axis, its opposite, the axis square to it, its opposite.
 std::array<Side, 4> SidesOf(const BoxFit& fit, double lu, double lv, const Eigen::Vector2d& o) {
     const Eigen::Vector2d a = fit.length_axis, b(-a.y(), a.x());
     return {Side{a, b, lv / 2.0, a.dot(o) + lu / 2.0}, Side{-a, b, lv / 2.0, -a.dot(o) + lu / 2.0},
             Side{b, a, lu / 2.0, b.dot(o) + lv / 2.0}, Side{-b, a, lu / 2.0, -b.dot(o) + lv / 2.0}};
 }
 
+// Returns whether nothing read the lowest row of cells of `side` (from the band up) while its
+// rows above were read; false where the face is too low to tell.
 bool FootUnread(const std::vector<Eigen::Vector3f>& pts, const Side& side,
                 const Eigen::Vector2d& center, double height, const EnvelopeConfig& config) {
     std::array<int, kProfileRows + 1> rows{};
