@@ -19,7 +19,8 @@
 //   - Other objects (tubes, bags, L-shapes, open flaps): the support function of the surface,
 //     h(φ) = the largest cell bound along direction φ over cells of the outer layer seen from φ,
 //     for φ every degree (then every 0.1 degree near the best); the footprint is the rectangle of
-//     least area (h(φ) + h(φ + π)) (h(φ + π/2) + h(φ − π/2)), the height the top's bound.
+//     least area (h(φ) + h(φ + π)) (h(φ + π/2) + h(φ − π/2)), the height the top's bound. A
+//     surface sloping across its cells along φ keeps its own layer (sloped_layers.h).
 // The object is a cuboid when its box fit succeeded, its footprint fills the rectangle and no
 // face stands out of its plane by more than a small fraction of the box.
 //   - One view: the cuboid is assumed (its unseen faces where the top's edges end), and said so.

@@ -1,0 +1,55 @@
+#pragma once
+// Envelope stage: the outer layer of a cell whose surface slopes across it.
+//
+// A direction's outer layer keeps a cell's readings within the layer's depth (layer_sigmas σ) of
+// the cell's outermost one (support_envelope.cpp). A surface that slopes across the cell along
+// the direction judged (a pyramid's or a wedge's face seen along its slope, a lying bottle's
+// flank) spreads over the cell by its extent times the slope, which may be many times that
+// depth; the layer then holds a sliver of it, too few readings to be judged however densely the
+// surface was read, and the less noise the thinner the sliver. The support fell back to cells
+// far inside, and the object was refused as one whose surface "stops well short of its own
+// readings". The outer layer is the surface, not a level: such a cell's layer is taken again
+// sub-cell by sub-cell (a quarter of the cell each way), each reading against the outermost of
+// its own sub-cell, among the readings a surface facing the direction within 60 degrees could
+// spread over across the cell (√3 times its diagonal). The cell is taken only where that layer
+// is one plane facing the direction within 60 degrees: its readings lie on it within the noise
+// (the test the cell's reach reads, surface_cells.cpp), and no more of them lie off it than the
+// noise's tail leaves (mixed pixels at a foot, a stray). Two surfaces sharing the cell (a ridge's
+// two faces, a wall's end, a thin panel's two sides) leave it unjudged, as before. A cell taken
+// counts as any other: read at its readings' mean, and at its high end where its slope goes on
+// downhill (layer_marks.h); a plane's outermost point read off so few readings overshot where a
+// sliver of a second surface passed for part of it (a wedge's end, 5-8 mm). Only cells whose
+// outermost reading stands beyond their row's judged cells are read again: a cell read at its
+// mean cannot pass them otherwise, and the rest cost a third of an irregular object's fit.
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "pipeline/envelope/enclosing_cuboid.h"
+#include "pipeline/envelope/surface_cells.h"
+
+namespace boxd::envelope {
+
+// The outer layers in direction u (front) and -u (back), over cells of (across, up).
+struct Layers {
+    CellGrid<LayerCell> front, back;
+};
+
+// The readings of one grid's layers: each reading's (across, up, along) coordinates and its
+// cell (-1: outside the grid), and each cell's largest and least `along` and its count.
+struct LayerReadings {
+    const std::vector<Eigen::Vector3d>* across_up_along;
+    const std::vector<long>* cell;
+    std::size_t grids, grid;  // cell[i * grids + grid] is reading i's cell in this grid
+    const std::vector<double>* max_along;
+    const std::vector<double>* min_along;
+    const std::vector<int>* count;
+};
+
+// Replaces every cell of `layers` (front and back) that holds fewer than config.min_cell_points
+// readings with its sloped surface's layer, where that layer holds enough readings and is one
+// plane facing the direction within the noise `sigma`.
+void FillSlopedCells(const LayerReadings& readings, double sigma, const EnvelopeConfig& config,
+                     Layers& layers);
+
+}  // namespace boxd::envelope

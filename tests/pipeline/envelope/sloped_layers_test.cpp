@@ -1,0 +1,176 @@
+// Known-answer tests of a sloped surface's outer layer (pipeline/envelope/sloped_layers.h): a
+// face sloping across its cells is judged however little noise it carries; a ridge's two faces,
+// a face steeper than 60 degrees and a face with mixed pixels standing off it are not; a pyramid
+// read with little noise is bounded by its faces instead of refused, and a thin fin standing out
+// of a box is still refused as an outline that cannot be bounded.
+#include "pipeline/envelope/sloped_layers.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "pipeline/envelope/support_envelope.h"
+
+namespace boxd::envelope {
+namespace {
+
+constexpr double kSigma = 0.0003;  // a third of a millimetre: the layer is 1.5 mm deep
+
+// Fills the 12 mm cells of 0 <= across, up < 0.048 m from readings of `along(t, z)` every
+// millimetre (noise kSigma), with `extra` readings added; every cell starts empty (starved).
+Layers Fill(const std::function<double(double, double)>& along,
+            const std::vector<Eigen::Vector3d>& extra = {}, unsigned seed = 1) {
+    const EnvelopeConfig config;
+    Layers out{CellGrid<LayerCell>(0.0, 0.048, 0.0, 0.048, 0.012, 0.012),
+               CellGrid<LayerCell>(0.0, 0.048, 0.0, 0.048, 0.012, 0.012)};
+    std::mt19937 rng(seed);
+    std::normal_distribution<double> noise(0.0, kSigma);
+    std::vector<Eigen::Vector3d> tzs;
+    for (double z = 0.0005; z < 0.048; z += 0.001) {
+        for (double t = 0.0005; t < 0.048; t += 0.001)
+            tzs.emplace_back(t, z, along(t, z) + noise(rng));
+    }
+    tzs.insert(tzs.end(), extra.begin(), extra.end());
+    std::vector<long> cell(tzs.size(), -1);
+    std::vector<double> max_s(out.front.cells.size(), -INFINITY), min_s(max_s.size(), INFINITY);
+    std::vector<int> count(max_s.size(), 0);
+    for (std::size_t i = 0; i < tzs.size(); ++i) {
+        const LayerCell* c = out.front.At(tzs[i].x(), tzs[i].y());
+        if (c == nullptr) continue;
+        const auto k = static_cast<std::size_t>(c - out.front.cells.data());
+        cell[i] = static_cast<long>(k);
+        max_s[k] = std::max(max_s[k], tzs[i].z());
+        min_s[k] = std::min(min_s[k], tzs[i].z());
+        ++count[k];
+    }
+    FillSlopedCells({&tzs, &cell, 1, 0, &max_s, &min_s, &count}, kSigma, config, out);
+    return out;
+}
+
+int Judged(const CellGrid<LayerCell>& grid) {
+    int n = 0;
+    for (const LayerCell& c : grid.cells) n += c.n >= EnvelopeConfig{}.min_cell_points ? 1 : 0;
+    return n;
+}
+
+TEST(SlopedLayers, AFaceSlopingAcrossItsCellsIsJudgedWhereALevelLayerHoldsASliver) {
+    // A wedge's face seen along its slope: 1.3 m in per metre up (its normal 52 degrees from
+    // the direction), 16 mm over a cell against a 1.5 mm layer.
+    const Layers f = Fill([](double, double z) { return 0.1 - 1.3 * z; });
+    EXPECT_EQ(Judged(f.front), 16);
+    for (const LayerCell& c : f.front.cells) {
+        // Each cell holds the outer part of its patch of the face, sub-cell by sub-cell (a
+        // twelfth of a level layer's), and its mean lies on the face.
+        ASSERT_GE(c.n, 48);
+        EXPECT_NEAR(c.Mean(), 0.1 - 1.3 * c.Centroid().y(), 3.0 * kSigma);
+    }
+}
+
+TEST(SlopedLayers, ASurfaceSteeperThanSixtyDegreesOrTwoSharingACellStayUnjudged) {
+    // Rising 2 m per metre: its normal 63 degrees from the direction (a wall crossing it).
+    EXPECT_EQ(Judged(Fill([](double, double z) { return 0.1 - 2.0 * z; }).front), 0);
+    // A ridge running across the cells 18 mm up (its two faces meet in the second row of
+    // cells): only the rows clear of it are judged.
+    const Layers ridge = Fill([](double, double z) { return 0.1 - 0.8 * std::abs(z - 0.018); });
+    for (int j = 0; j < ridge.front.nb; ++j) {
+        for (int i = 0; i < ridge.front.na; ++i) {
+            EXPECT_EQ(ridge.front.cells[j * ridge.front.na + i].n >= 12, j != 1)
+                << "cell " << i << ", " << j;
+        }
+    }
+}
+
+TEST(SlopedLayers, MixedPixelsStandingOffTheFaceLeaveItsCellUnjudged) {
+    auto face = [](double, double z) { return 0.1 - 1.3 * z; };
+    // Three readings a centimetre outside the face in the first cell, as mixed pixels between
+    // a foot and the table beyond it read.
+    const std::vector<Eigen::Vector3d> strays{{0.003, 0.004, 0.1 - 1.3 * 0.004 + 0.01},
+                                              {0.007, 0.005, 0.1 - 1.3 * 0.005 + 0.01},
+                                              {0.010, 0.009, 0.1 - 1.3 * 0.009 + 0.01}};
+    const Layers f = Fill(face, strays);
+    EXPECT_LT(f.front.cells[0].n, 12);
+    EXPECT_EQ(Judged(f.front), 15);
+}
+
+// Twelve cameras round the object, a metre away and 0.7 m up.
+void AddCameras(Surface& s) {
+    for (int k = 0; k < 12; ++k) {
+        const double phi = k * M_PI / 6.0;
+        s.cameras.emplace_back(std::cos(phi), std::sin(phi), 0.7);
+    }
+}
+
+// A pyramid on a 0.3 x 0.2 m base, 0.15 m tall, read every 1.5 mm over its faces above the
+// table's band with 0.3 mm of noise, seen from twelve cameras round it.
+Surface Pyramid() {
+    Surface s;
+    std::mt19937 rng(7);
+    std::normal_distribution<double> noise(0.0, kSigma);
+    const double a = 0.15, b = 0.10, h = 0.15;
+    for (double x = -a; x <= a; x += 0.0015) {
+        for (double y = -b; y <= b; y += 0.0015) {
+            const double z = h * (1.0 - std::max(std::abs(x) / a, std::abs(y) / b));
+            if (z < EnvelopeConfig{}.min_z_m) continue;
+            s.points.emplace_back(x, y, z + noise(rng));
+        }
+    }
+    AddCameras(s);
+    s.radius = std::hypot(a, b) + 0.01;
+    s.top = h + 0.01;
+    return s;
+}
+
+TEST(SlopedLayers, APyramidReadWithLittleNoiseIsBoundedByItsFaces) {
+    // Its corner ridges run down to the base's corners, and its faces slope across every cell
+    // of the diagonal directions: a layer of 1.5 mm held too few of their readings to judge, and
+    // the outline was refused as stopping well short of its readings.
+    const auto cuboid = EnvelopeCuboid(Pyramid(), kSigma, kSigma, EnvelopeConfig{});
+    ASSERT_TRUE(cuboid.ok()) << cuboid.error().message;
+    EXPECT_NEAR(cuboid->length_m, 0.30, 0.003);
+    EXPECT_NEAR(cuboid->width_m, 0.20, 0.003);
+    EXPECT_NEAR(cuboid->height_m, 0.15, 0.003);
+}
+
+TEST(SlopedLayers, AThinFinStandingOutOfABoxIsStillRefusedAsUnbounded) {
+    // A 0.2 m cube's sides and top read every 2 mm, and a fin 1 mm thick standing 40 mm out of
+    // one side, read every 3 mm on both its faces: its faces run along the direction it stands
+    // out in (no surface faces that way), so its cells hold too few readings to judge, sloped or
+    // not, and the outline stops short of its readings there.
+    Surface s;
+    std::mt19937 rng(3);
+    std::normal_distribution<double> noise(0.0, kSigma);
+    auto add = [&](double x, double y, double z) {
+        s.points.emplace_back(x + noise(rng), y + noise(rng), z + noise(rng));
+    };
+    const double h = 0.1;
+    for (double a = -0.1; a <= 0.1; a += 0.002) {
+        for (double z = 0.014; z <= h; z += 0.002) {
+            for (double side : {-0.1, 0.1}) {
+                add(side, a, z);
+                add(a, side, z);
+            }
+        }
+        for (double b = -0.1; b <= 0.1; b += 0.002) add(a, b, h);
+    }
+    for (double x = 0.1; x <= 0.14; x += 0.003) {
+        for (double z = 0.02; z <= 0.08; z += 0.003) {
+            add(x, -0.0005, z);
+            add(x, 0.0005, z);
+        }
+    }
+    AddCameras(s);
+    s.radius = 0.16;
+    s.top = h + 0.01;
+    const auto cuboid = EnvelopeCuboid(s, kSigma, kSigma, EnvelopeConfig{});
+    ASSERT_FALSE(cuboid.ok());
+    EXPECT_EQ(cuboid.error().code, ErrorCode::kInsufficientData);
+    EXPECT_NE(cuboid.error().message.find("cannot be bounded"), std::string::npos)
+        << cuboid.error().message;
+}
+
+}  // namespace
+}  // namespace boxd::envelope
