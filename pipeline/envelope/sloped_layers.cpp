@@ -58,8 +58,9 @@ int OffPlaneAllowed(int n) {
 // their layer but at least that many in all (`count`), whose outermost reading (`extreme`, as
 // the side reads it) stands beyond every judged cell's mean in their row. A cell is read at
 // its mean, which lies inside its outermost reading: one that cannot pass its row's judged
-// cells moves neither the support nor a row of the wall's profile (foot_band.h). Returns each
-// one's slot in the side's own arrays (-1 for the others), and how many there are.
+// cells becomes neither the support nor its row's outermost cell in the wall's profile
+// (foot_band.h), though it might have counted among the cells competing with them. Returns
+// each one's slot in the side's own arrays (-1 for the others), and how many there are.
 std::vector<int> Starved(const CellGrid<LayerCell>& grid, const std::vector<int>& count,
                          const std::vector<double>& extreme, double sign,
                          const EnvelopeConfig& config, int* slots) {

@@ -46,9 +46,11 @@ struct LayerReadings {
     const std::vector<int>* count;
 };
 
-// Replaces every cell of `layers` (front and back) that holds fewer than config.min_cell_points
-// readings with its sloped surface's layer, where that layer holds enough readings and is one
-// plane facing the direction within the noise `sigma`.
+// Replaces each cell of `layers` (front and back) that holds fewer than config.min_cell_points
+// readings in its layer, at least that many in all, and whose outermost reading stands beyond its
+// row's judged cells, with its sloped surface's layer, where that layer holds enough readings,
+// no more of them off its plane than the noise `sigma` leaves, and is one plane facing the
+// direction.
 void FillSlopedCells(const LayerReadings& readings, double sigma, const EnvelopeConfig& config,
                      Layers& layers);
 

@@ -1,5 +1,6 @@
 // Known-answer tests of a sloped surface's outer layer (pipeline/envelope/sloped_layers.h): a
-// face sloping across its cells is judged however little noise it carries; a ridge's two faces,
+// face sloping across its cells is judged however little noise it carries, front and back, where
+// it could pass its row's judged cells; a ridge's two faces,
 // a face steeper than 60 degrees and a face with mixed pixels standing off it are not; a pyramid
 // read with little noise is bounded by its faces instead of refused, and a thin fin standing out
 // of a box is still refused as an outline that cannot be bounded.
@@ -11,6 +12,7 @@
 #include <functional>
 #include <random>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "pipeline/envelope/support_envelope.h"
@@ -20,18 +22,21 @@ namespace {
 
 constexpr double kSigma = 0.0003;  // a third of a millimetre: the layer is 1.5 mm deep
 
-// Fills the 12 mm cells of 0 <= across, up < 0.048 m from readings of `along(t, z)` every
-// millimetre (noise kSigma), with `extra` readings added; every cell starts empty (starved).
+// The outer layers, front and back, of the 12 mm cells of 0 <= across, up < 0.048 m over
+// readings of `along(t, z)` every `spacing` m (noise kSigma), with `extra` readings added: each
+// cell's readings within the layer's depth of its outermost, as support_envelope.cpp's
+// BuildLayers takes them, and then (with `sloped`) the sloped surfaces' layers.
 Layers Fill(const std::function<double(double, double)>& along,
-            const std::vector<Eigen::Vector3d>& extra = {}, unsigned seed = 1) {
+            const std::vector<Eigen::Vector3d>& extra = {}, double spacing = 0.001,
+            bool sloped = true) {
     const EnvelopeConfig config;
     Layers out{CellGrid<LayerCell>(0.0, 0.048, 0.0, 0.048, 0.012, 0.012),
                CellGrid<LayerCell>(0.0, 0.048, 0.0, 0.048, 0.012, 0.012)};
-    std::mt19937 rng(seed);
+    std::mt19937 rng(1);
     std::normal_distribution<double> noise(0.0, kSigma);
     std::vector<Eigen::Vector3d> tzs;
-    for (double z = 0.0005; z < 0.048; z += 0.001) {
-        for (double t = 0.0005; t < 0.048; t += 0.001)
+    for (double z = spacing / 2; z < 0.048; z += spacing) {
+        for (double t = spacing / 2; t < 0.048; t += spacing)
             tzs.emplace_back(t, z, along(t, z) + noise(rng));
     }
     tzs.insert(tzs.end(), extra.begin(), extra.end());
@@ -47,7 +52,15 @@ Layers Fill(const std::function<double(double, double)>& along,
         min_s[k] = std::min(min_s[k], tzs[i].z());
         ++count[k];
     }
-    FillSlopedCells({&tzs, &cell, 1, 0, &max_s, &min_s, &count}, kSigma, config, out);
+    const double layer = config.layer_sigmas * kSigma;
+    for (std::size_t i = 0; i < tzs.size(); ++i) {
+        if (cell[i] < 0) continue;
+        const auto k = static_cast<std::size_t>(cell[i]);
+        const auto& [t, z, s] = std::tuple(tzs[i].x(), tzs[i].y(), tzs[i].z());
+        if (s >= max_s[k] - layer) out.front.cells[k].Add3(t, z, s);
+        if (s <= min_s[k] + layer) out.back.cells[k].Add3(-t, z, -s);
+    }
+    if (sloped) FillSlopedCells({&tzs, &cell, 1, 0, &max_s, &min_s, &count}, kSigma, config, out);
     return out;
 }
 
@@ -59,27 +72,54 @@ int Judged(const CellGrid<LayerCell>& grid) {
 
 TEST(SlopedLayers, AFaceSlopingAcrossItsCellsIsJudgedWhereALevelLayerHoldsASliver) {
     // A wedge's face seen along its slope: 1.3 m in per metre up (its normal 52 degrees from
-    // the direction), 16 mm over a cell against a 1.5 mm layer.
-    const Layers f = Fill([](double, double z) { return 0.1 - 1.3 * z; });
+    // the direction), 16 mm over a cell against a 1.5 mm layer, read every 2 mm.
+    auto face = [](double, double z) { return 0.1 - 1.3 * z; };
+    const Layers level = Fill(face, {}, 0.002, false);
+    EXPECT_EQ(Judged(level.front), 0);
+    EXPECT_EQ(Judged(level.back), 0);
+    const Layers f = Fill(face, {}, 0.002);
     EXPECT_EQ(Judged(f.front), 16);
-    for (const LayerCell& c : f.front.cells) {
-        // Each cell holds the outer part of its patch of the face, sub-cell by sub-cell (a
-        // twelfth of a level layer's), and its mean lies on the face.
-        ASSERT_GE(c.n, 48);
-        EXPECT_NEAR(c.Mean(), 0.1 - 1.3 * c.Centroid().y(), 3.0 * kSigma);
+    EXPECT_EQ(Judged(f.back), 16);  // the same face seen from behind (mirrored)
+    for (std::size_t k = 0; k < f.front.cells.size(); ++k) {
+        // Each cell holds the outer part of each of its sub-cells' patch of the face, and its
+        // mean lies on the face.
+        const LayerCell &c = f.front.cells[k], &b = f.back.cells[k];
+        EXPECT_NEAR(c.Mean(), face(0.0, c.Centroid().y()), 3.0 * kSigma);
+        EXPECT_NEAR(-b.Mean(), face(0.0, b.Centroid().y()), 3.0 * kSigma);
+        EXPECT_GT(c.n, level.front.cells[k].n);
+    }
+}
+
+TEST(SlopedLayers, ACellThatCannotPassItsRowsJudgedCellsIsLeftAsItWas) {
+    // The first column of cells is a wall facing the direction 0.2 m out (judged by its level
+    // layer); the rest slope as above, 0.1 m out at most: read at their means they cannot pass
+    // the wall, and only the wall's cells are judged.
+    const Layers f =
+        Fill([](double t, double z) { return t < 0.012 ? 0.2 : 0.1 - 1.3 * z; }, {}, 0.002);
+    for (int j = 0; j < f.front.nb; ++j) {
+        for (int i = 0; i < f.front.na; ++i) {
+            EXPECT_EQ(f.front.cells[j * f.front.na + i].n >= 12, i == 0) << i << ", " << j;
+        }
     }
 }
 
 TEST(SlopedLayers, ASurfaceSteeperThanSixtyDegreesOrTwoSharingACellStayUnjudged) {
-    // Rising 2 m per metre: its normal 63 degrees from the direction (a wall crossing it).
-    EXPECT_EQ(Judged(Fill([](double, double z) { return 0.1 - 2.0 * z; }).front), 0);
-    // A ridge running across the cells 18 mm up (its two faces meet in the second row of
-    // cells): only the rows clear of it are judged.
-    const Layers ridge = Fill([](double, double z) { return 0.1 - 0.8 * std::abs(z - 0.018); });
-    for (int j = 0; j < ridge.front.nb; ++j) {
-        for (int i = 0; i < ridge.front.na; ++i) {
-            EXPECT_EQ(ridge.front.cells[j * ridge.front.na + i].n >= 12, j != 1)
-                << "cell " << i << ", " << j;
+    // Rising 2 m per metre: its normal 63 degrees from the direction (a wall crossing it); at
+    // 1.3 m per metre the same cells are judged (above).
+    EXPECT_EQ(Judged(Fill([](double, double z) { return 0.1 - 2.0 * z; }, {}, 0.002).front), 0);
+    // A ridge running across the cells 18 mm up, read every 2 mm: its two faces meet in the
+    // second row of cells, which keeps its level layer (its crest); the rows clear of it, a
+    // face each, are judged.
+    auto ridge = [](double, double z) { return 0.1 - 0.8 * std::abs(z - 0.018); };
+    const Layers level = Fill(ridge, {}, 0.002, false), f = Fill(ridge, {}, 0.002);
+    for (int j = 0; j < f.front.nb; ++j) {
+        for (int i = 0; i < f.front.na; ++i) {
+            const std::size_t k = static_cast<std::size_t>(j * f.front.na + i);
+            if (j == 1) {
+                EXPECT_EQ(f.front.cells[k].n, level.front.cells[k].n) << i << ", " << j;
+            } else {
+                EXPECT_GE(f.front.cells[k].n, 12) << i << ", " << j;
+            }
         }
     }
 }
@@ -91,7 +131,7 @@ TEST(SlopedLayers, MixedPixelsStandingOffTheFaceLeaveItsCellUnjudged) {
     const std::vector<Eigen::Vector3d> strays{{0.003, 0.004, 0.1 - 1.3 * 0.004 + 0.01},
                                               {0.007, 0.005, 0.1 - 1.3 * 0.005 + 0.01},
                                               {0.010, 0.009, 0.1 - 1.3 * 0.009 + 0.01}};
-    const Layers f = Fill(face, strays);
+    const Layers f = Fill(face, strays, 0.002);
     EXPECT_LT(f.front.cells[0].n, 12);
     EXPECT_EQ(Judged(f.front), 15);
 }
