@@ -1,6 +1,5 @@
 #include "pipeline/envelope/sloped_layers.h"
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -29,22 +28,7 @@ struct Plane {
     double Off(const Eigen::Vector3d& p) const { return normal.dot(p - at); }
 };
 
-// (The closed-form decomposition, as LayerCell::Facing: it runs for cells of every direction.)
-Plane PlaneOf(const LayerCell& c) {
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-    eig.computeDirect(c.Scatter());
-    return {c.Centroid(), eig.eigenvectors().col(0)};
-}
-
-// Whether the cell's readings lie on one plane within the noise: their variance off their best
-// plane exceeds the noise's by less than three of its standard errors (as CellReach reads two
-// surfaces sharing a cell).
-bool OnOnePlane(const LayerCell& c, double sigma) {
-    double off_plane = 0.0;
-    c.Facing(&off_plane);
-    const double noise_var = sigma * sigma;
-    return off_plane <= noise_var + 3.0 * SampleVarianceSe(noise_var, c.n);
-}
+Plane PlaneOf(const LayerCell& c) { return {c.Centroid(), c.Normal()}; }
 
 // How many of n readings of one surface may lie beyond kOffPlaneSigmas of it: the binomial
 // count's mean and three of its standard deviations, for normal noise's share beyond.
@@ -143,10 +127,10 @@ void FillSide(const std::vector<Entry>& entries, const std::vector<int>& slot, i
         if (slot[c] < 0) continue;
         const auto k = static_cast<std::size_t>(slot[c]);
         const int off = first[k].n - kept[k].n;
-        if (kept[k].n < config.min_cell_points || off > OffPlaneAllowed(first[k].n) ||
-            !OnOnePlane(kept[k], sigma) || kept[k].Facing() < 0.5) {
-            continue;
-        }
+        if (kept[k].n < config.min_cell_points || off > OffPlaneAllowed(first[k].n)) continue;
+        double off_plane = 0.0;
+        const double facing = kept[k].Facing(&off_plane);
+        if (facing < 0.5 || !OnOnePlane(off_plane, sigma * sigma, kept[k].n)) continue;
         grid.cells[c] = kept[k];
     }
 }

@@ -44,6 +44,11 @@ double LayerCell::Facing(double* off_plane) const {
     return std::abs(eig.eigenvectors().col(0).z());
 }
 
+Eigen::Vector3d LayerCell::Normal() const {
+    Eigen::Matrix3d cov;
+    return Decompose(*this, &cov).eigenvectors().col(0);
+}
+
 LayerCell::Slope LayerCell::BestSlope(double noise_sigma) const {
     Eigen::Matrix3d cov;
     const auto eig = Decompose(*this, &cov);
@@ -68,6 +73,10 @@ double LayerCell::NarrowerExtentVariance() const {
 
 double SampleVarianceSe(double variance, int n) {
     return variance * std::sqrt(2.0 / std::max(1, n - 1));
+}
+
+bool OnOnePlane(double off_plane, double noise_var, int n) {
+    return off_plane <= noise_var + 3.0 * SampleVarianceSe(noise_var, n);
 }
 
 double HighEndSe(double variance, double spread_variance, int n) {
@@ -128,7 +137,6 @@ Reach CellReach(const LayerCell& c, const ReachModel& model) {
     double off_plane = 0.0;
     const double cos_t = std::min(1.0, c.Facing(&off_plane));
     const double var = c.Variance();
-    const double wander = 3.0 * SampleVarianceSe(noise_var, c.n);
     if (cos_t >= 0.5) {
         const double spread =
             std::min(model.cell_extent_m * std::sqrt(1.0 - cos_t * cos_t) / cos_t, model.layer);
@@ -140,8 +148,9 @@ Reach CellReach(const LayerCell& c, const ReachModel& model) {
     if (!model.walls || var - wall_var <= 3.0 * SampleVarianceSe(wall_var, c.n)) {
         return {c.Mean(), 0.0, c.StdError()};
     }
-    if (off_plane > noise_var + wander)
+    if (!OnOnePlane(off_plane, noise_var, c.n)) {
         return {c.Mean(), model.layer / std::sqrt(12.0), c.StdError()};
+    }
     const double high_end_se = HighEndSe(var, var - wall_var, c.n);
     return {c.Mean() + std::sqrt(3.0 * (var - wall_var)), high_end_se,
             std::hypot(c.StdError(), high_end_se)};

@@ -57,6 +57,8 @@ struct LayerCell : CellStats {
     // in `off_plane` (when given) the variance of the readings about their best plane: the
     // noise for one surface, more for two (a corner's faces sharing the cell).
     double Facing(double* off_plane = nullptr) const;
+    // The unit normal of the readings' best plane (the least spread of their scatter).
+    Eigen::Vector3d Normal() const;
     // The readings' best plane as a slope s(a, b): its gradient, and how far it rises across
     // the readings (the standard deviation of its values over their spread). No slope (zero)
     // when that spread is within twice the noise: depth noise smears a wall's end along the
@@ -85,6 +87,11 @@ double SampleVarianceSe(double variance, int n);
 // its readings' mean (readings spread evenly down from it): `spread_variance` is the readings'
 // sample `variance` (of `n`) less the noise's.
 double HighEndSe(double variance, double spread_variance, int n);
+
+// Whether `n` readings lie on one plane: their variance off their best plane (LayerCell::Facing)
+// exceeds the noise's `noise_var` by no more than three of its standard errors
+// (SampleVarianceSe). More is two surfaces sharing the cell.
+bool OnOnePlane(double off_plane, double noise_var, int n);
 
 // Returns Φ⁻¹(0.5^(1/m)): the median of the largest of m standard normal draws.
 double MedianOfLargest(int m);
