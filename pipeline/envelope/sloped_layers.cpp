@@ -77,8 +77,8 @@ std::array<std::vector<Entry>, 2> StarvedEntries(const LayerReadings& r, const L
         if (c < 0) continue;
         const auto k = static_cast<std::size_t>(c);
         const Eigen::Vector3d& q = (*r.across_up_along)[i];
-        const bool front = slot[0][k] >= 0 && q.z() >= (*r.max_along)[k] - window;
-        const bool back = slot[1][k] >= 0 && q.z() <= (*r.min_along)[k] + window;
+        const bool front = slot[0][k] >= 0 && q.z() >= r.max_along[k] - window;
+        const bool back = slot[1][k] >= 0 && q.z() <= r.min_along[k] + window;
         if (!front && !back) continue;
         const double ua = (q.x() - grid.a0) * per_a, ub = (q.y() - grid.b0) * per_b;
         const double fa = ua - std::floor(ua), fb = ub - std::floor(ub);
@@ -137,12 +137,43 @@ void FillSide(const std::vector<Entry>& entries, const std::vector<int>& slot, i
 
 }  // namespace
 
+LayerReadings CutLevelLayers(const std::vector<Eigen::Vector3d>& across_up_along,
+                             const std::vector<long>& cell, std::size_t grids, std::size_t grid,
+                             double sigma, const EnvelopeConfig& config, Layers& layers) {
+    const std::size_t cells = layers.front.cells.size();
+    LayerReadings out{&across_up_along,
+                      &cell,
+                      grids,
+                      grid,
+                      std::vector<double>(cells, -INFINITY),
+                      std::vector<double>(cells, INFINITY),
+                      std::vector<int>(cells, 0)};
+    for (std::size_t i = 0; i < across_up_along.size(); ++i) {
+        const long c = cell[i * grids + grid];
+        if (c < 0) continue;
+        const auto k = static_cast<std::size_t>(c);
+        out.max_along[k] = std::max(out.max_along[k], across_up_along[i].z());
+        out.min_along[k] = std::min(out.min_along[k], across_up_along[i].z());
+        ++out.count[k];
+    }
+    const double layer = config.layer_sigmas * sigma;
+    for (std::size_t i = 0; i < across_up_along.size(); ++i) {
+        const long c = cell[i * grids + grid];
+        if (c < 0) continue;
+        const auto k = static_cast<std::size_t>(c);
+        const Eigen::Vector3d& q = across_up_along[i];
+        if (q.z() >= out.max_along[k] - layer) layers.front.cells[k].Add3(q.x(), q.y(), q.z());
+        if (q.z() <= out.min_along[k] + layer) layers.back.cells[k].Add3(-q.x(), q.y(), -q.z());
+    }
+    return out;
+}
+
 void FillSlopedCells(const LayerReadings& readings, double sigma, const EnvelopeConfig& config,
                      Layers& layers) {
     int front = 0, back = 0;
     const std::array<std::vector<int>, 2> slot{
-        Starved(layers.front, *readings.count, *readings.max_along, 1.0, config, &front),
-        Starved(layers.back, *readings.count, *readings.min_along, -1.0, config, &back)};
+        Starved(layers.front, readings.count, readings.max_along, 1.0, config, &front),
+        Starved(layers.back, readings.count, readings.min_along, -1.0, config, &back)};
     if (front + back == 0) return;
     const auto entries = StarvedEntries(readings, layers, slot);
     FillSide(entries[0], slot[0], front, sigma, config, layers.front);

@@ -1,5 +1,6 @@
 #pragma once
-// Envelope stage: the outer layer of a cell whose surface slopes across it.
+// Envelope stage: a direction's outer layers (CutLevelLayers), and the outer layer of a cell
+// whose surface slopes across it (FillSlopedCells).
 //
 // A direction's outer layer keeps a cell's readings within the layer's depth (layer_sigmas σ) of
 // the cell's outermost one (support_envelope.cpp). A surface that slopes across the cell along
@@ -41,10 +42,17 @@ struct LayerReadings {
     const std::vector<Eigen::Vector3d>* across_up_along;
     const std::vector<long>* cell;
     std::size_t grids, grid;  // cell[i * grids + grid] is reading i's cell in this grid
-    const std::vector<double>* max_along;
-    const std::vector<double>* min_along;
-    const std::vector<int>* count;
+    std::vector<double> max_along, min_along;
+    std::vector<int> count;
 };
+
+// Adds to `layers` (grid `grid` of the `grids` whose cells `cell` holds, reading by reading) each
+// reading within config.layer_sigmas `sigma` of its cell's largest `along` to the front layer,
+// and of its least to the back (as (-across, up, -along)); returns the readings with their
+// cells' extremes and counts.
+LayerReadings CutLevelLayers(const std::vector<Eigen::Vector3d>& across_up_along,
+                             const std::vector<long>& cell, std::size_t grids, std::size_t grid,
+                             double sigma, const EnvelopeConfig& config, Layers& layers);
 
 // Replaces each cell of `layers` (front and back) that holds fewer than config.min_cell_points
 // readings in its layer, at least that many in all, and whose outermost reading stands beyond its

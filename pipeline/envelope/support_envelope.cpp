@@ -40,8 +40,8 @@ struct Support {
 };
 
 // The outer layers of several grids (cells of `sizes`: along, up), each reading projected once:
-// the readings' extremes per cell, the layers within config.layer_sigmas sigma of them, and a
-// sloped surface's where that leaves a cell too few readings (sloped_layers.h).
+// the layers within config.layer_sigmas sigma of their cells' extremes, and a sloped surface's
+// where that leaves a cell too few readings (sloped_layers.h).
 std::vector<Layers> BuildLayers(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector2d& u,
                                 double sigma, double radius, double top,
                                 const std::vector<std::pair<double, double>>& sizes,
@@ -49,14 +49,9 @@ std::vector<Layers> BuildLayers(const std::vector<Eigen::Vector3f>& pts, const E
     const Eigen::Vector2d v(-u.y(), u.x());
     const std::size_t grids = sizes.size();
     std::vector<Layers> out;
-    std::vector<std::vector<double>> max_s, min_s;
-    std::vector<std::vector<int>> count;
     for (const auto& [along, up] : sizes) {
         out.push_back({CellGrid<LayerCell>(-radius, radius, 0.0, top, along, up),
                        CellGrid<LayerCell>(-radius, radius, 0.0, top, along, up)});
-        max_s.emplace_back(out.back().front.cells.size(), -INFINITY);
-        min_s.emplace_back(out.back().front.cells.size(), INFINITY);
-        count.emplace_back(out.back().front.cells.size(), 0);
     }
     // Each reading's (across, up, along), and its cell in each grid (-1: outside it).
     std::vector<Eigen::Vector3d> tzs(pts.size());
@@ -66,28 +61,15 @@ std::vector<Layers> BuildLayers(const std::vector<Eigen::Vector3f>& pts, const E
         tzs[i] = {v.dot(q), pts[i].z(), u.dot(q)};
         for (std::size_t g = 0; g < grids; ++g) {
             CellGrid<LayerCell>& front = out[g].front;
-            const LayerCell* c = front.At(tzs[i].x(), tzs[i].y());
-            if (c == nullptr) continue;
-            const auto k = static_cast<std::size_t>(c - front.cells.data());
-            cell[i * grids + g] = static_cast<long>(k);
-            max_s[g][k] = std::max(max_s[g][k], tzs[i].z());
-            min_s[g][k] = std::min(min_s[g][k], tzs[i].z());
-            ++count[g][k];
+            if (const LayerCell* c = front.At(tzs[i].x(), tzs[i].y())) {
+                cell[i * grids + g] = static_cast<long>(c - front.cells.data());
+            }
         }
     }
-    const double layer = config.layer_sigmas * sigma;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-        const double t = tzs[i].x(), z = tzs[i].y(), s = tzs[i].z();
-        for (std::size_t g = 0; g < grids; ++g) {
-            if (cell[i * grids + g] < 0) continue;
-            const auto k = static_cast<std::size_t>(cell[i * grids + g]);
-            if (s >= max_s[g][k] - layer) out[g].front.cells[k].Add3(t, z, s);
-            if (s <= min_s[g][k] + layer) out[g].back.cells[k].Add3(-t, z, -s);
-        }
-    }
-    for (std::size_t g = 0; g < grids; ++g)
-        FillSlopedCells({&tzs, &cell, grids, g, &max_s[g], &min_s[g], &count[g]}, sigma, config,
+    for (std::size_t g = 0; g < grids; ++g) {
+        FillSlopedCells(CutLevelLayers(tzs, cell, grids, g, sigma, config, out[g]), sigma, config,
                         out[g]);
+    }
     return out;
 }
 

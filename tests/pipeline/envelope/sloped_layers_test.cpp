@@ -12,7 +12,6 @@
 #include <functional>
 #include <random>
 #include <string>
-#include <tuple>
 #include <vector>
 
 #include "pipeline/envelope/support_envelope.h"
@@ -24,8 +23,8 @@ constexpr double kSigma = 0.0003;  // a third of a millimetre: the layer is 1.5 
 
 // The outer layers, front and back, of the 12 mm cells of 0 <= across, up < 0.048 m over
 // readings of `along(t, z)` every `spacing` m (noise kSigma), with `extra` readings added: each
-// cell's readings within the layer's depth of its outermost, as support_envelope.cpp's
-// BuildLayers takes them, and then (with `sloped`) the sloped surfaces' layers.
+// cell's readings within the layer's depth of its outermost (CutLevelLayers, as support_envelope's
+// BuildLayers takes them), and then (with `sloped`) the sloped surfaces' layers.
 Layers Fill(const std::function<double(double, double)>& along,
             const std::vector<Eigen::Vector3d>& extra = {}, double spacing = 0.001,
             bool sloped = true) {
@@ -41,26 +40,13 @@ Layers Fill(const std::function<double(double, double)>& along,
     }
     tzs.insert(tzs.end(), extra.begin(), extra.end());
     std::vector<long> cell(tzs.size(), -1);
-    std::vector<double> max_s(out.front.cells.size(), -INFINITY), min_s(max_s.size(), INFINITY);
-    std::vector<int> count(max_s.size(), 0);
     for (std::size_t i = 0; i < tzs.size(); ++i) {
-        const LayerCell* c = out.front.At(tzs[i].x(), tzs[i].y());
-        if (c == nullptr) continue;
-        const auto k = static_cast<std::size_t>(c - out.front.cells.data());
-        cell[i] = static_cast<long>(k);
-        max_s[k] = std::max(max_s[k], tzs[i].z());
-        min_s[k] = std::min(min_s[k], tzs[i].z());
-        ++count[k];
+        if (const LayerCell* c = out.front.At(tzs[i].x(), tzs[i].y())) {
+            cell[i] = static_cast<long>(c - out.front.cells.data());
+        }
     }
-    const double layer = config.layer_sigmas * kSigma;
-    for (std::size_t i = 0; i < tzs.size(); ++i) {
-        if (cell[i] < 0) continue;
-        const auto k = static_cast<std::size_t>(cell[i]);
-        const auto& [t, z, s] = std::tuple(tzs[i].x(), tzs[i].y(), tzs[i].z());
-        if (s >= max_s[k] - layer) out.front.cells[k].Add3(t, z, s);
-        if (s <= min_s[k] + layer) out.back.cells[k].Add3(-t, z, -s);
-    }
-    if (sloped) FillSlopedCells({&tzs, &cell, 1, 0, &max_s, &min_s, &count}, kSigma, config, out);
+    const LayerReadings readings = CutLevelLayers(tzs, cell, 1, 0, kSigma, config, out);
+    if (sloped) FillSlopedCells(readings, kSigma, config, out);
     return out;
 }
 
