@@ -107,19 +107,20 @@ void ExpectCleanStop(test::ServeDaemon& daemon, const Launcher& launcher, const 
     for (pid_t pid : LaunchedPids(launcher)) EXPECT_FALSE(Alive(pid)) << "simulator " << pid;
 }
 
-// The integrator's start-up: POST /v1/measure?wait=1 0.2 s after health first answers, while the
-// slow first launch of the turntable is still being opened. Before one owner opened the devices,
-// this crashed the daemon every time (a second open replaced the devices a capture was using).
+// The integrator's start-up: POST /v1/measure?wait=1 soon after health first answers, while the
+// slow first launch of the turntable (1.5 s) is still being opened. Before one owner opened the
+// devices, this crashed the daemon every time (a second open replaced the devices a capture was
+// using). Each round lands the POST at another moment of the open, from at once to its end.
 TEST(ServeStartup, AMeasurementDuringTheStartUpOpenWaitsForTheDevices) {
-    for (int round = 0; round < 20; ++round) {
-        SCOPED_TRACE("round " + std::to_string(round));
+    for (const auto delay : {0ms, 50ms, 200ms, 600ms, 1000ms, 1400ms}) {
+        SCOPED_TRACE("POST " + std::to_string(delay.count()) + " ms after health answers");
         test::TempDir dir;
         const Launcher launcher = WriteLauncher(dir.path(), 1.5, "", 0.0);
         test::ServeDaemon daemon(WriteConfig(dir.path(), launcher), dir / "data",
                                  dir / "serve.log");
         ASSERT_TRUE(WaitAnswers(daemon, 60s)) << ReadText(dir / "serve.log");
         EXPECT_EQ(daemon.GetJson("/v1/status")["state"], "starting");
-        std::this_thread::sleep_for(200ms);
+        std::this_thread::sleep_for(delay);
         const json result = MeasureAndWait(daemon, dir / "serve.log");
         EXPECT_EQ(result.value("status", ""), "ok") << result.dump();
         EXPECT_TRUE(daemon.process().Running()) << ReadText(dir / "serve.log");
