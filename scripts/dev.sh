@@ -108,11 +108,12 @@ sanitize_build() {
 
 # Under ASan the calibration's Ceres problems run ~20x slower: these tests, which repeat the
 # calibration on more seeds or stations (or through the daemon, or with a time-of-flight
-# camera's multipath correction: over 10 minutes alone), take ~45 minutes on 2 cores.
+# camera's multipath correction: over 10 minutes alone, or a camera without edge growth or a
+# depth pattern, whose calibration runs the same code as one with it), take ~45 minutes on 2 cores.
 # `scripts/dev.sh test` (CI) leaves them out of the sanitizer run; `sanitize` runs all.
 # The Debian package and the operator page in Chromium check packaging and a browser, not
 # boxd's memory: they run in the plain suite only.
-SANITIZE_SLOW='FocalScaleStation|CliTimeOfFlight[.]|ServeAudit[.]Counts|LShapesLeanOverSeeds|CliCalibrate[.](Calibrates|RefusesWhenNoGeometry|ShowsABar)|ServeCalibrationHistory|RecoversInjectedErrors.*seed1[23]|Accuracy[.]|DebianPackage[.]|OperatorPage[.]'
+SANITIZE_SLOW='FocalScaleStation|CliEdgeGrowth[.]EdgesThatDoNotGrow|CliDepthPattern[.]ACameraWithoutAPattern|CliTimeOfFlight[.]|ServeAudit[.]Counts|LShapesLeanOverSeeds|CliCalibrate[.](Calibrates|RefusesWhenNoGeometry|ShowsABar)|ServeCalibrationHistory|RecoversInjectedErrors.*seed1[23]|Accuracy[.]|DebianPackage[.]|OperatorPage[.]'
 
 sanitize() {
     sanitize_build
