@@ -24,7 +24,9 @@ bool NonNegative(double v) { return std::isfinite(v) && v >= 0.0; }
 struct AveragingPass {
     std::vector<const std::uint16_t*> src;  // the frames' pixel arrays
     std::size_t required = 1;               // valid readings a pixel needs
-    std::vector<std::uint32_t> window;      // agreement window (raw units) by median reading
+    // Twice the agreement window (raw units) by the lower median reading: the median of an even
+    // count lies half-way between two readings, so the readings are compared doubled.
+    std::vector<std::uint32_t> window;
     // When the readings come in levels, each recorded value's depth in 1/kFixedScale raw units,
     // so that sums stay integer (without levels, a value's depth is itself times kFixedScale).
     bool levels = false;
@@ -44,19 +46,24 @@ float FixedMean(std::uint64_t sum, std::uint64_t kept, double unit) {
 }
 
 // Averages the pass's N frames into *out, pixel by pixel (a refused pixel stays 0). The rule:
-// the lower median of the valid readings, then the mean of those within the median's agreement
-// window, when they are enough and a strict majority.
+// the median of the valid readings (of an even count, the mean of the middle two), then the mean
+// of those within its agreement window (the window of the lower middle reading's depth), when
+// they are enough and a strict majority. The lower middle reading alone would centre the window
+// nearer than the readings' middle, and where the noise is as wide as the window (a surface
+// seen at grazing incidence) keep more of the near readings than of the far ones: at four frames
+// a pose of twice a Kinect's noise, a box's sides read 0.4 mm out.
 // N fixed at compile time, and nothing branches on the readings (they are noise: any branch on
 // them would be mispredicted about half the time), so the median loop vectorises. A reading
-// of 0 (no return) ranks above every valid one: the lower median of the k valid readings is
-// the one with (k - 1) / 2 readings before it (ties broken by frame order).
+// of 0 (no return) ranks above every valid one: the middle two of the k valid readings are
+// those with (k - 1) / 2 and k / 2 readings before them (ties broken by frame order).
+// `median` holds their sum, twice the median.
 // kLevels: the readings are read at their levels (pass.fixed), which the compiler cannot gather
 // as fast as it shifts the values themselves.
 template <std::size_t N, bool kLevels>
 void AverageAll(const AveragingPass& pass, DepthMap* out) {
     constexpr std::size_t kBlock = 1024;
     constexpr std::int32_t kNone = 0x10000;  // above every 16-bit reading
-    std::array<std::uint32_t, kBlock> median{}, valid{}, tol{}, sums{}, agreeing{};
+    std::array<std::uint32_t, kBlock> median{}, lower_median{}, valid{}, tol{}, sums{}, agreeing{};
     const std::size_t count = out->z_m.size();
     for (std::size_t start = 0; start < count; start += kBlock) {
         const std::size_t len = std::min(kBlock, count - start);
@@ -69,28 +76,30 @@ void AverageAll(const AveragingPass& pass, DepthMap* out) {
                 k += v != 0 ? 1 : 0;
                 r[f] = v != 0 ? v : kNone;
             }
-            const std::int32_t m = (k > 0 ? k - 1 : 0) / 2;
-            std::int32_t med = 0;
+            const std::int32_t lo = (k > 0 ? k - 1 : 0) / 2, hi = k / 2;
+            std::int32_t lower = 0, upper = 0;
             for (std::size_t a = 0; a < N; ++a) {
                 std::int32_t rank = 0;
                 for (std::size_t b = 0; b < N; ++b) {
                     rank += (r[b] < r[a] || (r[b] == r[a] && b < a)) ? 1 : 0;
                 }
-                med += rank == m ? r[a] : 0;
+                lower += rank == lo ? r[a] : 0;
+                upper += rank == hi ? r[a] : 0;
             }
-            median[p] = static_cast<std::uint32_t>(med);
+            median[p] = static_cast<std::uint32_t>(lower + upper);
+            lower_median[p] = static_cast<std::uint32_t>(lower);
             valid[p] = static_cast<std::uint32_t>(k);
         }
         // The agreement windows (a table lookup; a pixel without readings looks up the entry
         // past the 16-bit range), then each pixel's agreeing readings, again without a branch.
-        for (std::size_t p = 0; p < len; ++p) tol[p] = pass.window[median[p]];
+        for (std::size_t p = 0; p < len; ++p) tol[p] = pass.window[lower_median[p]];
         for (std::size_t p = 0; p < len; ++p) {
             const auto med = static_cast<std::int32_t>(median[p]);
             const auto window = static_cast<std::int32_t>(tol[p]);
             std::int32_t sum = 0, kept = 0;
             for (std::size_t f = 0; f < N; ++f) {
                 const std::int32_t v = pass.src[f][start + p];
-                const std::int32_t d = v > med ? v - med : med - v;
+                const std::int32_t d = 2 * v > med ? 2 * v - med : med - 2 * v;
                 const bool agrees = v != 0 && d <= window;
                 const std::int32_t depth =
                     kLevels ? pass.fixed[static_cast<std::size_t>(v)] : v << kFixedBits;
@@ -129,15 +138,17 @@ void AveragePixelAnyCount(const AveragingPass& pass, std::size_t i, std::uint16_
     if (k < pass.required) return;
     const std::size_t m = (k - 1) / 2;
     std::nth_element(r, r + m, r + k);
-    const std::uint32_t median = r[m];
-    const std::uint32_t tol = pass.window[median];
+    const std::uint32_t lower = r[m];
+    const std::uint32_t upper = k % 2 == 1 ? lower : *std::min_element(r + m + 1, r + k);
+    const std::uint32_t median = lower + upper;  // twice the median
+    const std::uint32_t tol = pass.window[lower];
     std::uint64_t sum = 0;
     std::size_t kept = 0;
     for (std::size_t j = 0; j < k; ++j) {
-        const std::uint32_t v = r[j];
+        const std::uint32_t v = 2 * static_cast<std::uint32_t>(r[j]);
         if ((v > median ? v - median : median - v) <= tol) {
-            sum += pass.levels ? static_cast<std::uint64_t>(pass.fixed[v])
-                               : static_cast<std::uint64_t>(v) << kFixedBits;
+            sum += pass.levels ? static_cast<std::uint64_t>(pass.fixed[r[j]])
+                               : static_cast<std::uint64_t>(r[j]) << kFixedBits;
             ++kept;
         }
     }
@@ -190,16 +201,16 @@ void ReadLevels(const std::vector<DepthImage>& frames, double depth_unit_m, Aver
     }
 }
 
-// The agreement window of SPEC section 7's sensor model grows with depth: looked up per raw
-// median reading (in raw units) instead of computed in metres for every pixel. The last entry
-// is a pixel without readings (never used).
+// The agreement window of SPEC section 7's sensor model grows with depth: twice the window,
+// looked up per raw lower median reading (in raw units) instead of computed in metres for every
+// pixel. The last entry is a pixel without readings (never used).
 std::vector<std::uint32_t> AgreementWindows(const AveragingConfig& config, double depth_unit_m) {
     std::vector<std::uint32_t> window(kValues + 1);
     for (std::size_t v = 0; v < window.size(); ++v) {
         const double z = static_cast<double>(v) * depth_unit_m;
         const double tol = config.agreement_abs_m + config.agreement_rel_per_m * z * z;
         // Truncation is the floor here (the window is never negative), and it vectorises.
-        window[v] = static_cast<std::uint32_t>(std::min(65535.0, tol / depth_unit_m));
+        window[v] = static_cast<std::uint32_t>(std::min(131070.0, 2.0 * tol / depth_unit_m));
     }
     return window;
 }

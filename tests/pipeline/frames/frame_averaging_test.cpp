@@ -45,6 +45,18 @@ TEST(AverageDepthFrames, DropsPixelsWhoseReadingsDisagree) {
     EXPECT_EQ(avg->at(2, 2), 0.0f);
 }
 
+TEST(AverageDepthFrames, AnEvenCountIsJudgedFromTheMiddleOfItsReadings) {
+    // Spread as wide as the 16 mm window at 1 m: judged from the lower middle reading (1010),
+    // the farthest would be dropped and the mean pulled 5 mm nearer; the median is 1015.
+    auto avg = AverageDepthFrames(Frames({1000, 1010, 1020, 1030}), 0.001, AveragingConfig{});
+    ASSERT_TRUE(avg.ok());
+    EXPECT_NEAR(avg->at(2, 2), 1.015f, 1e-6f);
+    // Symmetric: mirrored about the median, the readings average to it as well.
+    avg = AverageDepthFrames(Frames({1030, 1020, 1010, 1000}), 0.001, AveragingConfig{});
+    ASSERT_TRUE(avg.ok());
+    EXPECT_NEAR(avg->at(2, 2), 1.015f, 1e-6f);
+}
+
 TEST(AverageDepthFrames, RejectsMismatchedSizesAndNoFrames) {
     auto frames = Frames({1000, 1000});
     frames.push_back(DepthImage(4, 3));
@@ -52,8 +64,8 @@ TEST(AverageDepthFrames, RejectsMismatchedSizesAndNoFrames) {
     EXPECT_FALSE(AverageDepthFrames({}, 0.001, AveragingConfig{}).ok());
 }
 
-// The averaging rule written plainly (sort, lower median, window in metres): the reference the
-// branch-free implementation must reproduce.
+// The averaging rule written plainly (sort, median, window in metres at the lower middle
+// reading): the reference the branch-free implementation must reproduce.
 float ReferenceAverage(std::vector<std::uint16_t> readings, double unit, std::size_t required,
                        const AveragingConfig& c) {
     std::vector<std::uint16_t> valid;
@@ -62,8 +74,9 @@ float ReferenceAverage(std::vector<std::uint16_t> readings, double unit, std::si
     }
     if (valid.size() < required) return 0.0f;
     std::sort(valid.begin(), valid.end());
-    const double median = valid[(valid.size() - 1) / 2] * unit;
-    const double tol = c.agreement_abs_m + c.agreement_rel_per_m * median * median;
+    const double lower = valid[(valid.size() - 1) / 2] * unit;
+    const double median = 0.5 * (lower + valid[valid.size() / 2] * unit);
+    const double tol = c.agreement_abs_m + c.agreement_rel_per_m * lower * lower;
     double sum = 0.0;
     std::size_t kept = 0;
     for (std::uint16_t v : valid) {
