@@ -51,7 +51,11 @@ float FixedMean(std::uint64_t sum, std::uint64_t kept, double unit) {
 // they are enough and a strict majority. The lower middle reading alone would centre the window
 // nearer than the readings' middle, and where the noise is as wide as the window (a surface
 // seen at grazing incidence) keep more of the near readings than of the far ones: at four frames
-// a pose of twice a Kinect's noise, a box's sides read 0.4 mm out.
+// a pose of twice a Kinect's noise, a box's sides read 0.4 mm out. Two readings alone agree when
+// they lie within the window of each other, not of their mean: no third says which one a wider
+// gap belongs to, and their mean would be a reading of neither (at two frames a pose, a
+// time-of-flight camera's mixed pixels at a frustum's top, averaged with the top, read it 2.9 mm
+// high).
 // N fixed at compile time, and nothing branches on the readings (they are noise: any branch on
 // them would be mispredicted about half the time), so the median loop vectorises. A reading
 // of 0 (no return) ranks above every valid one: the middle two of the k valid readings are
@@ -92,7 +96,9 @@ void AverageAll(const AveragingPass& pass, DepthMap* out) {
         }
         // The agreement windows (a table lookup; a pixel without readings looks up the entry
         // past the 16-bit range), then each pixel's agreeing readings, again without a branch.
-        for (std::size_t p = 0; p < len; ++p) tol[p] = pass.window[lower_median[p]];
+        for (std::size_t p = 0; p < len; ++p) {
+            tol[p] = pass.window[lower_median[p]] >> (valid[p] == 2 ? 1 : 0);
+        }
         for (std::size_t p = 0; p < len; ++p) {
             const auto med = static_cast<std::int32_t>(median[p]);
             const auto window = static_cast<std::int32_t>(tol[p]);
@@ -141,7 +147,7 @@ void AveragePixelAnyCount(const AveragingPass& pass, std::size_t i, std::uint16_
     const std::uint32_t lower = r[m];
     const std::uint32_t upper = k % 2 == 1 ? lower : *std::min_element(r + m + 1, r + k);
     const std::uint32_t median = lower + upper;  // twice the median
-    const std::uint32_t tol = pass.window[lower];
+    const std::uint32_t tol = pass.window[lower] >> (k == 2 ? 1 : 0);
     std::uint64_t sum = 0;
     std::size_t kept = 0;
     for (std::size_t j = 0; j < k; ++j) {
