@@ -29,6 +29,10 @@ constexpr int kDropBins = 6;
 constexpr std::size_t kBinReadings = 5;
 // Flanks steeper than this (84 degrees) are walls: the top is their edge, read as it stands.
 constexpr double kMaxSlope = 10.0;
+// A point's flanks are read in this many sectors round it (a pyramid's four faces and the
+// edges between them), the steepest setting how high the apex may stand.
+constexpr int kFlankSectors = 8;
+constexpr std::size_t kFlankReadings = 20;  // a flank's plane needs this many readings
 
 // The median over views of the median distance from a reading of the top to the nearest other
 // reading of the same view (all readings as one view where `view` is empty): how finely a view
@@ -109,6 +113,42 @@ std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top,
     return 1.0 / run;
 }
 
+// The slope (rise per metre) of the plane fitted to `flank`'s readings, the steepest way up
+// it; none for fewer than kFlankReadings readings or a plane standing upright. The plane is the
+// readings' least-variance axis, not a fit of their heights: a reading's noise lies along its
+// ray, across the flank as much as up it, and heights fitted against noisy places read a flank
+// gentler than it is (a pyramid's 1.61 face read 1.48 by a stereo camera 1.1 m away).
+std::optional<double> PlaneSlope(const std::vector<Eigen::Vector3f>& flank) {
+    if (flank.size() < kFlankReadings) return std::nullopt;
+    LayerCell cell;  // its (across, up, along) here (x, y, z)
+    for (const Eigen::Vector3f& p : flank) cell.Add3(p.x(), p.y(), p.z());
+    const Eigen::Vector3d normal = cell.Normal();
+    if (!(std::abs(normal.z()) > 0.0)) return std::nullopt;
+    return normal.head<2>().norm() / std::abs(normal.z());
+}
+
+// The steepest of a point's flanks, at least `slope` (theirs together, FlankSlope): the plane
+// of each of kFlankSectors sectors round it (a pyramid's faces, and the edges between them,
+// which fit gentler). A face's plane gives its own slope whichever way across it the readings
+// lie; their median run together (FlankSlope's) reads a pyramid's steeper faces up to half as
+// steep, and the apex then stands higher above the readings than the reach allowed.
+double SteepestFlank(const std::vector<Eigen::Vector3f>& top, const Eigen::Vector2d& apex,
+                     double slope) {
+    std::vector<std::vector<Eigen::Vector3f>> flanks(kFlankSectors);
+    for (const Eigen::Vector3f& p : top) {
+        const Eigen::Vector2d q = p.head<2>().cast<double>() - apex;
+        const double turn = (std::atan2(q.y(), q.x()) + M_PI) / (2.0 * M_PI);
+        const int k = std::min(kFlankSectors - 1, static_cast<int>(turn * kFlankSectors));
+        flanks[static_cast<std::size_t>(k)].push_back(p);
+    }
+    double steepest = slope;
+    for (const auto& flank : flanks) {
+        const auto s = PlaneSlope(flank);
+        if (s) steepest = std::max(steepest, std::min(*s, kMaxSlope));
+    }
+    return steepest;
+}
+
 }  // namespace
 
 PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
@@ -151,9 +191,14 @@ PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
     const auto slope =
         FlankSlope(top, apex, ridge ? &across : nullptr, out.highest, band_m, narrow_m);
     if (!slope) return out;
-    out.slope = *slope;
+    // The apex may stand above the readings by its steepest flank's rise over the farthest it
+    // may lie from the nearest: across a ridge, half the readings' spacing; a point among
+    // readings spread both ways, half the diagonal of their spacing. Or over half the narrowest
+    // width the fusion keeps, where that is wider.
+    out.slope = ridge ? *slope : SteepestFlank(top, apex, *slope);
     out.spacing = ViewSpacing(top, top_view);
-    out.above = out.slope * std::max(out.spacing, narrowest_m) / 2.0;
+    const double farthest = ridge ? out.spacing / 2.0 : out.spacing / std::sqrt(2.0);
+    out.above = out.slope * std::max(farthest, narrowest_m / 2.0);
     out.sharp = true;
     return out;
 }
