@@ -12,8 +12,9 @@ namespace boxd {
 struct AveragingConfig {
     // A pixel needs valid readings in at least this fraction of the frames (and at least one).
     double min_valid_fraction = 0.5;
-    // Readings farther than abs + rel * z^2 from the pixel's median are rejected as disagreeing;
-    // the z^2 term follows the quadratic growth of structured-light depth noise.
+    // Readings farther than abs + rel * z^2 from the pixel's median (of an even count, the mean
+    // of the middle two) are rejected as disagreeing; two readings alone, farther than that from
+    // each other. The z^2 term follows the quadratic growth of structured-light depth noise.
     double agreement_abs_m = 0.006;
     double agreement_rel_per_m = 0.01;
     // Read each recorded value as the depth of the sensor's level it was rounded from, when the
