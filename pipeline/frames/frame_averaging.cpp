@@ -45,6 +45,14 @@ float FixedMean(std::uint64_t sum, std::uint64_t kept, double unit) {
                               static_cast<double>(kept));
 }
 
+// How far (doubled raw units) a reading may lie from twice the median of `valid` readings whose
+// lower middle one is `lower`: twice the window, but for two readings alone, which must lie within
+// the window of each other (see AverageAll).
+inline std::uint32_t AgreementTolerance(const AveragingPass& pass, std::uint32_t lower,
+                                        std::uint32_t valid) {
+    return pass.window[lower] >> (valid == 2 ? 1 : 0);
+}
+
 // Averages the pass's N frames into *out, pixel by pixel (a refused pixel stays 0). The rule:
 // the median of the valid readings (of an even count, the mean of the middle two), then the mean
 // of those within its agreement window (the window of the lower middle reading's depth), when
@@ -97,7 +105,7 @@ void AverageAll(const AveragingPass& pass, DepthMap* out) {
         // The agreement windows (a table lookup; a pixel without readings looks up the entry
         // past the 16-bit range), then each pixel's agreeing readings, again without a branch.
         for (std::size_t p = 0; p < len; ++p) {
-            tol[p] = pass.window[lower_median[p]] >> (valid[p] == 2 ? 1 : 0);
+            tol[p] = AgreementTolerance(pass, lower_median[p], valid[p]);
         }
         for (std::size_t p = 0; p < len; ++p) {
             const auto med = static_cast<std::int32_t>(median[p]);
@@ -147,7 +155,7 @@ void AveragePixelAnyCount(const AveragingPass& pass, std::size_t i, std::uint16_
     const std::uint32_t lower = r[m];
     const std::uint32_t upper = k % 2 == 1 ? lower : *std::min_element(r + m + 1, r + k);
     const std::uint32_t median = lower + upper;  // twice the median
-    const std::uint32_t tol = pass.window[lower] >> (k == 2 ? 1 : 0);
+    const std::uint32_t tol = AgreementTolerance(pass, lower, static_cast<std::uint32_t>(k));
     std::uint64_t sum = 0;
     std::size_t kept = 0;
     for (std::size_t j = 0; j < k; ++j) {
