@@ -135,6 +135,9 @@ def main():
     # The cloud drawn: a canvas with more lit pixels than its background's edges (a "0" from a
     # draw before the canvas had its size is not drawn yet).
     drawn = "+((document.querySelector('#view canvas') || {dataset: {}}).dataset.litPixels || 0) > 500"
+    # The history loaded: its header row is made when the list arrives (the cloud, fetched beside
+    # it, may be drawn first on a loaded machine).
+    drawn += " && document.querySelector('#history-table th') !== null"
     for n, step in enumerate(steps):
         result = {"step": step}
         if step[0].isdigit():
@@ -151,7 +154,11 @@ def main():
         elif step == "measure":
             before = browser.evaluate("document.getElementById('last-id').textContent")
             browser.evaluate("document.getElementById('measure').click()")
-            result["live_seen"] = browser.wait_for("!document.getElementById('live').hidden", 10)
+            # The panel opens as the measurement is claimed and names it a moment later, once
+            # its id is reserved in the store.
+            result["live_seen"] = browser.wait_for(
+                "!document.getElementById('live').hidden && "
+                "document.getElementById('live-id').textContent !== ''", 10)
             result["during"] = json.loads(browser.evaluate(PROBE))
             result["during_screenshot"] = screenshot(browser, os.path.join(out, "%d-during.png" % n))
             result["finished"] = browser.wait_for(
