@@ -26,8 +26,10 @@ wedges lying on a face, frusta (cartons tapering 5-40 mm a side), pyramids, bags
 sacks bulging low, lying bottles, cartons on chamfered bases (5-40 mm), a small carton standing on
 a larger one and cartons with a strap looped above the top, on stations drawn as for the parcels
 but with a time-of-flight camera too (its station's surfaces reflecting 5-60%); each kind is
-reported per sensor. For every mode the summary counts confident wrong numbers: a
-dimension whose true error is larger than twice its reported 95% bound plus 1 mm.
+reported per sensor, then each shape over the sensors and each sensor over the shapes, with
+how many of the objects wholly in view (not refused OBJECT_TOO_LARGE) were refused. For every
+mode the summary counts confident wrong numbers: a dimension whose true error is larger than
+twice its reported 95% bound plus 1 mm.
 
 With --effects each object also gets one effect of real cameras drawn evenly (a dark foot,
 a projector's or second imager's shadows, fattened edges, correlated noise, a fixed pattern, or
@@ -359,6 +361,10 @@ def main():
     print(f"confident wrong numbers (|error| > 2 x bound + 1 mm): {wrong} of {len(pairs)}")
     for kind in sorted({o["kind"] for o in outcomes if "kind" in o}):
         print("  " + kind_line(kind, [o for o in outcomes if o.get("kind") == kind]))
+    if args.objects == "shapes":  # each shape over the sensors, and each sensor over the shapes
+        for group in (lambda o: o["kind"].rsplit(" ", 1)[0], lambda o: o["kind"].rsplit(" ", 1)[1]):
+            for name in sorted({group(o) for o in outcomes}):
+                print("  " + kind_line(name, [o for o in outcomes if group(o) == name]))
     for effect in sorted({o["effect"] for o in outcomes if "effect" in o}):
         print("  " + kind_line(effect, [o for o in outcomes if o.get("effect") == effect]))
     worst = max(e for e, _ in pairs)
@@ -373,6 +379,11 @@ def kind_line(kind, outcomes):
     measured = [o for o in outcomes if "error_mm" in o]
     refused = sorted(o.get("reason", o["status"]) for o in outcomes if "error_mm" not in o)
     codes = ", ".join(f"{c} {refused.count(c)}" for c in sorted(set(refused))) or "none refused"
+    # Refused although the whole object was in view (not cut by the image's border).
+    in_view = [o for o in outcomes if o.get("reason") != "OBJECT_TOO_LARGE"]
+    if len(in_view) < len(outcomes) or refused:
+        codes += (f"; {sum('error_mm' not in o for o in in_view)} of {len(in_view)} in view "
+                  "refused")
     mine = [(abs(e), b) for o in measured for e, b in zip(o["error_mm"], o["bound_mm"])]
     if not mine:
         return f"{kind:18s}: 0 of {len(outcomes)} measured ({codes})"
