@@ -33,6 +33,11 @@ constexpr double kSigma = 0.0015;  // sensor noise per point
 inline const Eigen::Vector3d kOverhead(0.0, 0.0, 3.0);
 constexpr double kViewShift = 0.0003;  // per-view registration error, per axis
 constexpr double kStep = 0.004;        // sampling grid of each view
+// The tolerance of a face. A face plane is fitted to thousands of points, so the noise moves it by
+// sigma / sqrt(n) ~ 0.02 mm; what moves it is the views' registration error: 0.3 mm per view,
+// averaged over the ~3 views that see a face, ~0.2 mm per face, ~0.25 mm per dimension —
+// 1 mm is 4 of those.
+constexpr double kFaceTol = 0.001;
 
 // A fused cloud built view by view: each surface point p (object frame) with outward unit
 // normal n goes to every view facing it, with that view's noise (sigma) and shift.
