@@ -115,6 +115,108 @@ TEST(ServeConfig, BadValuesNameTheKeyAndExitWith2) {
         << listkey.err;
 }
 
+// The first result on config/sim.yaml (`log`: the daemon's): the simulated box within 2 mm, and
+// how its capture ended.
+void ExpectTheSimulatedBox(const json& first, const YAML::Node& sim, const std::string& log) {
+    const double true_l = sim["camera"]["simulated"]["box"]["length_m"].as<double>();
+    const double true_w = sim["camera"]["simulated"]["box"]["width_m"].as<double>();
+    const double true_h = sim["camera"]["simulated"]["box"]["height_m"].as<double>();
+    const json& d = first["dimensions"];
+    EXPECT_NEAR(d["length_m"].get<double>(), true_l, 0.002) << first.dump(2);
+    EXPECT_NEAR(d["width_m"].get<double>(), true_w, 0.002) << first.dump(2);
+    EXPECT_NEAR(d["height_m"].get<double>(), true_h, 0.002) << first.dump(2);
+    // The table stopped turning once the box was determined: fewer poses than the budget,
+    // every 95% bound within the target, and the result says why it stopped.
+    const int budget = sim["capture"]["poses"].as<int>();
+    const double target = sim["capture"]["target_uncertainty_m"].as<double>();
+    EXPECT_GE(first["quality"]["poses"].get<int>(), 4);
+    EXPECT_LT(first["quality"]["poses"].get<int>(), budget) << first.dump(2);
+    EXPECT_EQ(first["quality"]["stop_reason"], "target_uncertainty") << first.dump(2);
+    for (const char* k : {"length_m", "width_m", "height_m"}) {
+        EXPECT_LE(first["uncertainty_m"][k].get<double>(), target) << k;
+    }
+    EXPECT_EQ(first["shape"], "cuboid");
+    EXPECT_GT(first["timing_ms"]["capture"].get<double>(), 0.0);
+    // The views and their alignments were made pose by pose while the table moved on: the
+    // log says how many poses were streamed when the capture ended (pose 0 was, long
+    // before the last one).
+    const auto at = log.find(" poses streamed during the capture");
+    ASSERT_NE(at, std::string::npos) << log;
+    const auto of = log.rfind(" of ", at);
+    const int early = std::stoi(log.substr(log.rfind(' ', of - 1) + 1));
+    EXPECT_GE(early, 1) << log.substr(of - 20, 80);
+}
+
+// The stored result read back every way (last, by parcel id, by id), the metrics it counts and
+// the process's own, the OpenAPI document and the fused cloud.
+void ExpectServedAndCounted(Daemon& daemon, const json& first) {
+    auto& client = daemon.client();
+    EXPECT_EQ(daemon.GetJson("/v1/measurements/last"), first);
+    EXPECT_EQ(daemon.GetJson("/v1/measurements?parcel_id=PKG-0042")["measurements"],
+              json::array({first}));
+    EXPECT_EQ(daemon.GetJson("/v1/measurements/m-000001"), first);
+    auto metrics = client.Get("/metrics");
+    ASSERT_TRUE(metrics);
+    ASSERT_EQ(metrics->status, 200);
+    const auto samples = test::ParsePrometheus(metrics->body);
+    EXPECT_EQ(samples.at("boxd_measurements_total{status=\"ok\"}"), 1) << metrics->body;
+    EXPECT_EQ(samples.at("boxd_measurement_cycle_seconds_count"), 1);
+    EXPECT_NEAR(samples.at("boxd_measurement_cycle_seconds_sum"),
+                first["timing_ms"]["total"].get<double>() / 1e3, 1e-3);
+    EXPECT_EQ(samples.at("boxd_calibrated"), 1);
+    // The config's calibration section does not say when it was made: no age is made up
+    // (the config file's time is not the calibration's).
+    EXPECT_EQ(samples.count("boxd_calibration_age_seconds"), 0u) << metrics->body;
+    // The standard process metrics, as a client library's would be.
+    const double now = static_cast<double>(std::time(nullptr));
+    EXPECT_GT(samples.at("process_resident_memory_bytes"), 10e6);
+    EXPECT_GE(samples.at("process_virtual_memory_bytes"),
+              samples.at("process_resident_memory_bytes"));
+    EXPECT_GT(samples.at("process_cpu_seconds_total"), 0.0);
+    EXPECT_NEAR(samples.at("process_start_time_seconds"), now - 30.0, 60.0);
+    EXPECT_GT(samples.at("process_open_fds"), 3.0);
+    EXPECT_LT(samples.at("process_open_fds"), samples.at("process_max_fds"));
+    const json openapi = daemon.GetJson("/v1/openapi.json");
+    for (const char* path : {"/", "/v1/measure", "/v1/measurements/{id}", "/metrics"}) {
+        EXPECT_TRUE(openapi["paths"].contains(path)) << path;
+    }
+    auto cloud = client.Get("/v1/measurements/m-000001/cloud.ply");
+    ASSERT_TRUE(cloud);
+    EXPECT_EQ(cloud->status, 200);
+    EXPECT_EQ(cloud->body.rfind("ply", 0), 0u);
+    EXPECT_GT(cloud->body.size(), 1000u);
+}
+
+// Second measurement, started without waiting: a POST while it runs is refused; GETs and bad
+// requests are answered meanwhile.
+void ExpectServingWhileBusy(Daemon& daemon) {
+    auto& client = daemon.client();
+    auto started = client.Post("/v1/measure", "", "application/json");
+    ASSERT_TRUE(started);
+    ASSERT_EQ(started->status, 202) << started->body;
+    EXPECT_EQ(json::parse(started->body)["id"], "m-000002");
+    auto busy = client.Post("/v1/measure?wait=1", "", "application/json");
+    ASSERT_TRUE(busy);
+    EXPECT_EQ(busy->status, 409);
+    EXPECT_EQ(json::parse(busy->body)["error"]["code"], "BUSY");
+    const json status = daemon.GetJson("/v1/status");
+    EXPECT_EQ(status["state"], "measuring") << status.dump();
+    EXPECT_EQ(status["measurement_id"], "m-000002") << status.dump();
+    auto malformed = client.Post("/v1/calibrate", "{\"reference_m\": [", "application/json");
+    ASSERT_TRUE(malformed);
+    EXPECT_EQ(malformed->status, 400);
+    auto unknown = client.Get("/v1/measurements/m-000001/nothing");
+    ASSERT_TRUE(unknown);
+    EXPECT_EQ(unknown->status, 404);
+    auto oversize = client.Post("/v1/measure", std::string(1 << 20, ' '), "application/json");
+    ASSERT_TRUE(oversize);
+    EXPECT_EQ(oversize->status, 413);
+    EXPECT_EQ(json::parse(oversize->body)["error"]["code"], "PAYLOAD_TOO_LARGE");
+    auto health = client.Get("/v1/health");
+    ASSERT_TRUE(health);
+    EXPECT_EQ(health->status, 200);
+}
+
 // The whole chain on config/sim.yaml: measure, read back, cloud, bad requests and a refused
 // second POST while busy; kill -9 mid-measurement; restart on the same data folder: the stored
 // measurement is served, the interrupted id is never reused, and history is newest first.
@@ -122,9 +224,6 @@ TEST(ServeSimStation, MeasuresTheSimulatedBoxAndServesItAcrossKill9) {
     test::TempDir dir;
     const fs::path data = dir / "data";
     const YAML::Node sim = YAML::LoadFile(kSimConfig.string());
-    const double true_l = sim["camera"]["simulated"]["box"]["length_m"].as<double>();
-    const double true_w = sim["camera"]["simulated"]["box"]["width_m"].as<double>();
-    const double true_h = sim["camera"]["simulated"]["box"]["height_m"].as<double>();
     json first;
     {
         Daemon daemon(kSimConfig, data, dir / "serve1.log");
@@ -143,94 +242,9 @@ TEST(ServeSimStation, MeasuresTheSimulatedBoxAndServesItAcrossKill9) {
         EXPECT_EQ(first["id"], "m-000001");
         EXPECT_EQ(first["parcel_id"], "PKG-0042");
         ASSERT_EQ(first["status"], "ok") << first.dump(2) << ReadText(dir / "serve1.log");
-        const json& d = first["dimensions"];
-        EXPECT_NEAR(d["length_m"].get<double>(), true_l, 0.002) << first.dump(2);
-        EXPECT_NEAR(d["width_m"].get<double>(), true_w, 0.002) << first.dump(2);
-        EXPECT_NEAR(d["height_m"].get<double>(), true_h, 0.002) << first.dump(2);
-        // The table stopped turning once the box was determined: fewer poses than the budget,
-        // every 95% bound within the target, and the result says why it stopped.
-        const int budget = sim["capture"]["poses"].as<int>();
-        const double target = sim["capture"]["target_uncertainty_m"].as<double>();
-        EXPECT_GE(first["quality"]["poses"].get<int>(), 4);
-        EXPECT_LT(first["quality"]["poses"].get<int>(), budget) << first.dump(2);
-        EXPECT_EQ(first["quality"]["stop_reason"], "target_uncertainty") << first.dump(2);
-        for (const char* k : {"length_m", "width_m", "height_m"}) {
-            EXPECT_LE(first["uncertainty_m"][k].get<double>(), target) << k;
-        }
-        EXPECT_EQ(first["shape"], "cuboid");
-        EXPECT_GT(first["timing_ms"]["capture"].get<double>(), 0.0);
-        // The views and their alignments were made pose by pose while the table moved on: the
-        // log says how many poses were streamed when the capture ended (pose 0 was, long
-        // before the last one).
-        const std::string log = ReadText(dir / "serve1.log");
-        const auto at = log.find(" poses streamed during the capture");
-        ASSERT_NE(at, std::string::npos) << log;
-        const auto of = log.rfind(" of ", at);
-        const int early = std::stoi(log.substr(log.rfind(' ', of - 1) + 1));
-        EXPECT_GE(early, 1) << log.substr(of - 20, 80);
-
-        EXPECT_EQ(daemon.GetJson("/v1/measurements/last"), first);
-        EXPECT_EQ(daemon.GetJson("/v1/measurements?parcel_id=PKG-0042")["measurements"],
-                  json::array({first}));
-        EXPECT_EQ(daemon.GetJson("/v1/measurements/m-000001"), first);
-        auto metrics = client.Get("/metrics");
-        ASSERT_TRUE(metrics);
-        ASSERT_EQ(metrics->status, 200);
-        const auto samples = test::ParsePrometheus(metrics->body);
-        EXPECT_EQ(samples.at("boxd_measurements_total{status=\"ok\"}"), 1) << metrics->body;
-        EXPECT_EQ(samples.at("boxd_measurement_cycle_seconds_count"), 1);
-        EXPECT_NEAR(samples.at("boxd_measurement_cycle_seconds_sum"),
-                    first["timing_ms"]["total"].get<double>() / 1e3, 1e-3);
-        EXPECT_EQ(samples.at("boxd_calibrated"), 1);
-        // The config's calibration section does not say when it was made: no age is made up
-        // (the config file's time is not the calibration's).
-        EXPECT_EQ(samples.count("boxd_calibration_age_seconds"), 0u) << metrics->body;
-        // The standard process metrics, as a client library's would be.
-        const double now = static_cast<double>(std::time(nullptr));
-        EXPECT_GT(samples.at("process_resident_memory_bytes"), 10e6);
-        EXPECT_GE(samples.at("process_virtual_memory_bytes"),
-                  samples.at("process_resident_memory_bytes"));
-        EXPECT_GT(samples.at("process_cpu_seconds_total"), 0.0);
-        EXPECT_NEAR(samples.at("process_start_time_seconds"), now - 30.0, 60.0);
-        EXPECT_GT(samples.at("process_open_fds"), 3.0);
-        EXPECT_LT(samples.at("process_open_fds"), samples.at("process_max_fds"));
-        const json openapi = daemon.GetJson("/v1/openapi.json");
-        for (const char* path : {"/", "/v1/measure", "/v1/measurements/{id}", "/metrics"}) {
-            EXPECT_TRUE(openapi["paths"].contains(path)) << path;
-        }
-        auto cloud = client.Get("/v1/measurements/m-000001/cloud.ply");
-        ASSERT_TRUE(cloud);
-        EXPECT_EQ(cloud->status, 200);
-        EXPECT_EQ(cloud->body.rfind("ply", 0), 0u);
-        EXPECT_GT(cloud->body.size(), 1000u);
-
-        // Second measurement, started without waiting: a POST while it runs is refused; GETs
-        // and bad requests are answered meanwhile.
-        auto started = client.Post("/v1/measure", "", "application/json");
-        ASSERT_TRUE(started);
-        ASSERT_EQ(started->status, 202) << started->body;
-        EXPECT_EQ(json::parse(started->body)["id"], "m-000002");
-        auto busy = client.Post("/v1/measure?wait=1", "", "application/json");
-        ASSERT_TRUE(busy);
-        EXPECT_EQ(busy->status, 409);
-        EXPECT_EQ(json::parse(busy->body)["error"]["code"], "BUSY");
-        const json status = daemon.GetJson("/v1/status");
-        EXPECT_EQ(status["state"], "measuring") << status.dump();
-        EXPECT_EQ(status["measurement_id"], "m-000002") << status.dump();
-        auto malformed = client.Post("/v1/calibrate", "{\"reference_m\": [", "application/json");
-        ASSERT_TRUE(malformed);
-        EXPECT_EQ(malformed->status, 400);
-        auto unknown = client.Get("/v1/measurements/m-000001/nothing");
-        ASSERT_TRUE(unknown);
-        EXPECT_EQ(unknown->status, 404);
-        auto oversize = client.Post("/v1/measure", std::string(1 << 20, ' '), "application/json");
-        ASSERT_TRUE(oversize);
-        EXPECT_EQ(oversize->status, 413);
-        EXPECT_EQ(json::parse(oversize->body)["error"]["code"], "PAYLOAD_TOO_LARGE");
-        auto health = client.Get("/v1/health");
-        ASSERT_TRUE(health);
-        EXPECT_EQ(health->status, 200);
-
+        ExpectTheSimulatedBox(first, sim, ReadText(dir / "serve1.log"));
+        ExpectServedAndCounted(daemon, first);
+        ExpectServingWhileBusy(daemon);
         daemon.process().Signal(SIGKILL);  // mid-measurement
         EXPECT_EQ(daemon.process().WaitExit(5s), 128 + SIGKILL);
     }
