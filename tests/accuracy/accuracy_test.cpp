@@ -188,13 +188,9 @@ double RmsStandardised(const std::vector<double>& errors, const std::vector<doub
     return n > 0 ? std::sqrt(sum / n) : NAN;
 }
 
-TEST(Accuracy, SyntheticSuiteWithinTolerance) {
-    std::ifstream in(std::string(BOXD_SOURCE_DIR) + "/tests/accuracy/cases.json");
-    ASSERT_TRUE(in) << "tests/accuracy/cases.json not found";
-    const json cases = json::parse(in)["cases"];
-    ASSERT_GE(cases.size(), 28u);
+// Runs every case of `cases`, two at a time: the CI machine has two cores.
+std::vector<Outcome> RunCases(const json& cases) {
     std::vector<Outcome> outcomes(cases.size());
-    // Two cases at a time: the CI machine has two cores.
     std::vector<std::thread> workers;
     for (int w = 0; w < 2; ++w) {
         workers.emplace_back([&, w] {
@@ -204,6 +200,42 @@ TEST(Accuracy, SyntheticSuiteWithinTolerance) {
         });
     }
     for (auto& t : workers) t.join();
+    return outcomes;
+}
+
+// Prints the ideal boxes' median bound against their median |error|, pooled and per dimension
+// (`box_errors` and `box_bounds` per dimension), with what exactly calibrated bounds would read.
+void PrintBoxBounds(const std::array<std::vector<double>, 3>& box_errors,
+                    const std::array<std::vector<double>, 3>& box_bounds) {
+    std::vector<double> all_errors, all_bounds;
+    for (std::size_t k = 0; k < 3; ++k) {
+        all_errors.insert(all_errors.end(), box_errors[k].begin(), box_errors[k].end());
+        all_bounds.insert(all_bounds.end(), box_bounds[k].begin(), box_bounds[k].end());
+    }
+    std::printf("ideal boxes: median bound %.2f mm, median |error| %.2f mm\n",
+                Median(all_bounds) * 1000, Median(all_errors) * 1000);
+    // Pooled, the heights' errors (hundredths) make the lower half of the errors and the
+    // footprint's bounds (tenths) the upper half of the bounds: each dimension against itself
+    // says what a bound is worth (a calibrated one is 2.9 times the median |error|).
+    const char* dims[3] = {"length", "width", "height"};
+    for (std::size_t k = 0; k < 3; ++k) {
+        const double b = Median(box_bounds[k]), e = Median(box_errors[k]);
+        const auto calibrated = CalibratedRatio(box_bounds[k]);
+        std::printf(
+            "ideal boxes, %-6s: median bound %.2f mm, median |error| %.2f mm (%.1fx; calibrated "
+            "bounds of these sizes read %.1fx, 90%% of draws %.1f-%.1fx); RMS of error / sigma "
+            "%.2f\n",
+            dims[k], b * 1000, e * 1000, e > 0.0 ? b / e : NAN, calibrated[1], calibrated[0],
+            calibrated[2], RmsStandardised(box_errors[k], box_bounds[k]));
+    }
+}
+
+TEST(Accuracy, SyntheticSuiteWithinTolerance) {
+    std::ifstream in(std::string(BOXD_SOURCE_DIR) + "/tests/accuracy/cases.json");
+    ASSERT_TRUE(in) << "tests/accuracy/cases.json not found";
+    const json cases = json::parse(in)["cases"];
+    ASSERT_GE(cases.size(), 28u);
+    const std::vector<Outcome> outcomes = RunCases(cases);
 
     std::map<std::string, std::array<double, 3>> worst;
     int covered = 0, judged = 0;
@@ -237,27 +269,7 @@ TEST(Accuracy, SyntheticSuiteWithinTolerance) {
     }
     std::printf("true error within the reported 95%% bound: %d of %d dimensions\n", covered,
                 judged);
-    std::vector<double> all_errors, all_bounds;
-    for (std::size_t k = 0; k < 3; ++k) {
-        all_errors.insert(all_errors.end(), box_errors[k].begin(), box_errors[k].end());
-        all_bounds.insert(all_bounds.end(), box_bounds[k].begin(), box_bounds[k].end());
-    }
-    std::printf("ideal boxes: median bound %.2f mm, median |error| %.2f mm\n",
-                Median(all_bounds) * 1000, Median(all_errors) * 1000);
-    // Pooled, the heights' errors (hundredths) make the lower half of the errors and the
-    // footprint's bounds (tenths) the upper half of the bounds: each dimension against itself
-    // says what a bound is worth (a calibrated one is 2.9 times the median |error|).
-    const char* dims[3] = {"length", "width", "height"};
-    for (std::size_t k = 0; k < 3; ++k) {
-        const double b = Median(box_bounds[k]), e = Median(box_errors[k]);
-        const auto calibrated = CalibratedRatio(box_bounds[k]);
-        std::printf(
-            "ideal boxes, %-6s: median bound %.2f mm, median |error| %.2f mm (%.1fx; calibrated "
-            "bounds of these sizes read %.1fx, 90%% of draws %.1f-%.1fx); RMS of error / sigma "
-            "%.2f\n",
-            dims[k], b * 1000, e * 1000, e > 0.0 ? b / e : NAN, calibrated[1], calibrated[0],
-            calibrated[2], RmsStandardised(box_errors[k], box_bounds[k]));
-    }
+    PrintBoxBounds(box_errors, box_bounds);
     std::printf("\n");
     // SPEC section 5's bound holds for 95% of the dimensions (docs/measuring.md's accuracy suite
     // names the misses: biases of the methods that no spread of the data shows).
