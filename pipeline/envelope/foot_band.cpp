@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace boxd::envelope {
@@ -83,6 +84,24 @@ std::optional<PolyFit> FitRows(const std::vector<RowReach>& rows, int degree) {
     return out;
 }
 
+// Returns the lowest of `rows` (`row_height` apart) that are one wall: the profile ends below
+// the first row that departs from the line through the rows under it by more than a row's
+// height. Between them the surface runs nearer level than upright against that line: a ledge,
+// and the rows above it are another wall (a small box standing on a larger one, an L's step),
+// which a line through both ran out to the table as far as the ledge is deep. A flank's rows,
+// plane or bending, stay within their noise and curvature of it.
+std::vector<RowReach> OneWall(std::vector<RowReach> rows, double row_height) {
+    for (std::size_t k = 2; k < rows.size(); ++k) {
+        const auto below = FitRows(std::vector<RowReach>(rows.begin(), rows.begin() + k), 1);
+        if (below && std::abs(rows[k].s - (below->at_table - below->slope * rows[k].z)) >
+                         row_height) {
+            rows.resize(k);
+            break;
+        }
+    }
+    return rows;
+}
+
 // Whether the rows between the band and row `first` hold fewer readings than one judged cell:
 // nothing read the wall there (a few strays aside), rather than too few readings to judge a
 // cell (the narrow foot of a lying tube's round end).
@@ -121,15 +140,18 @@ FootReach ExtrapolateFoot(const CellGrid<LayerCell>& layer, const EnvelopeConfig
         if (!r) break;
         rows.push_back(*r);
     }
+    rows = OneWall(std::move(rows), layer.db);
     if (rows.size() < 3) return out;
     const auto line = FitRows(rows, 1);
-    // The profile above its lowest row must slope outward too: one row standing out alone is no
-    // flank (a silhouette's few stray readings beside an upright tube at its foot).
+    // The profile above its lowest row, and below its highest, must slope outward too: one row
+    // standing out alone is no flank (a silhouette's few stray readings beside an upright tube at
+    // its foot), nor one standing in above an upright foot (a ledge's wall).
     const auto upper = FitRows(std::vector<RowReach>(rows.begin() + 1, rows.end()), 1);
-    if (!line || !upper || !(line->slope > kSlopeSigmas * line->slope_se) ||
-        !(upper->slope > kSlopeSigmas * upper->slope_se)) {
-        return out;
-    }
+    const auto lower = FitRows(std::vector<RowReach>(rows.begin(), rows.end() - 1), 1);
+    const auto outward = [](const std::optional<PolyFit>& f) {
+        return f && f->slope > kSlopeSigmas * f->slope_se;
+    };
+    if (!outward(line) || !outward(upper) || !outward(lower)) return out;
     out.slope = line->slope;
     out.reach = line->at_table;
     double variance = line->at_table_se * line->at_table_se;

@@ -1,8 +1,8 @@
 // Known-answer tests of the foot band (pipeline/envelope/foot_band.h): a wall's outer layer read
 // from the band's top up, as the support function bins it, and where the extension puts the wall's
 // foot on the table — a flank sloping outward (a prism's, a frustum's), an upright wall, an
-// undercut one, a wall nothing read near the table (raised) or read too sparsely there, and a
-// bending profile, over several seeds.
+// undercut one, a wall below a ledge, a wall nothing read near the table (raised) or read too
+// sparsely there, and a bending profile, over several seeds.
 #include "pipeline/envelope/foot_band.h"
 
 #include <gtest/gtest.h>
@@ -68,6 +68,28 @@ TEST(FootBand, ALowestRowStandingOutAloneIsNotExtended) {
     };
     EXPECT_FALSE(
         std::isfinite(ExtrapolateFoot(Layer(stray, config.min_z_m, 0.2, 1, config), config).reach));
+}
+
+// A ledge ends the wall: a small box standing on a larger one, its wall 150 mm in. The rows above
+// the ledge are another wall; a line through both ran the foot out to the table by as much
+// (a 351 x 237 mm box on a box read 483 x 342 mm). An upright foot stays; a flank below a ledge
+// is extended from its own rows.
+TEST(FootBand, ALedgeEndsTheWallItsProfileIsReadFrom) {
+    const EnvelopeConfig config;
+    for (double ledge : {0.03, 0.045, 0.06}) {
+        auto stacked = [ledge](double z) { return z < ledge ? 0.20 : 0.05; };
+        auto flank = [ledge](double z) { return z < ledge ? 0.06 - 0.577 * z : -0.1; };
+        for (unsigned seed = 1; seed <= 5; ++seed) {
+            EXPECT_FALSE(std::isfinite(
+                ExtrapolateFoot(Layer(stacked, config.min_z_m, 0.1, seed, config), config).reach))
+                << "ledge at " << ledge << ", seed " << seed;
+            const FootReach foot =
+                ExtrapolateFoot(Layer(flank, config.min_z_m, 0.1, seed, config), config);
+            if (!std::isfinite(foot.reach)) continue;  // two rows below the ledge: no profile
+            EXPECT_LT(std::abs(foot.reach - 0.060), 2.0 * foot.se + 1e-4)
+                << "ledge at " << ledge << ", seed " << seed;
+        }
+    }
 }
 
 // Nothing read below 50 mm (a dark base): the wall is extended from its lowest rows and marked
