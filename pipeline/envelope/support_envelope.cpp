@@ -161,6 +161,10 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
 struct Alike {
     int orientations = 1;
     double along_u = 0.0, along_v = 0.0;  // mean sides along the least rectangle's u and v
+    // Their mean standard errors: neighbouring directions share their readings, so the mean of
+    // the sides is known no better than they are (a side reached out by an uncertain foot is
+    // alike by its wide error, and its reach counts in the mean).
+    double se_u = 0.0, se_v = 0.0;
 };
 
 Alike AlikeRectangles(const std::vector<Support>& supports, int best) {
@@ -177,7 +181,7 @@ Alike AlikeRectangles(const std::vector<Support>& supports, int best) {
     const auto least = sides(best);
     const double step = M_PI / n;
     const double faceted = 2.0 * area_se(least) / (least[0] * least[0] + least[1] * least[1]);
-    double sum_u = 0.0, sum_v = 0.0, widest = 0.0;
+    double sum_u = 0.0, sum_v = 0.0, sum_se_u = 0.0, sum_se_v = 0.0, widest = 0.0;
     int count = 0;
     for (int i = 0; i < n / 2; ++i) {
         const auto s = sides(i);
@@ -190,6 +194,8 @@ Alike AlikeRectangles(const std::vector<Support>& supports, int best) {
         widest = std::max(widest, step * std::min(off, n / 2 - off));
         sum_u += same ? s[0] : s[1];
         sum_v += same ? s[1] : s[0];
+        sum_se_u += same ? s[2] : s[3];
+        sum_se_v += same ? s[3] : s[2];
         ++count;
     }
     if (widest <= faceted + step) return {};
@@ -209,7 +215,7 @@ Alike AlikeRectangles(const std::vector<Support>& supports, int best) {
     }
     const double growth = (sta - st * sa / points) / (stt - st * st / points);
     if (growth >= 0.5 * (least[0] * least[0] + least[1] * least[1]) * step) return {};
-    return {count, sum_u / count, sum_v / count};
+    return {count, sum_u / count, sum_v / count, sum_se_u / count, sum_se_v / count};
 }
 
 // An unseen side leaves the object unbounded there: a bulge or a flap could stand out
@@ -262,7 +268,9 @@ Result<EnclosingCuboid> CuboidOf(const Surface& surface, const LeastRectangle& r
     double se_top = 0.0;
     c.height_m = TopBound(surface.points, sigma, height_sigma, surface.radius, config, &se_top);
     ReadSharpTop(surface, height_sigma, config, &c.height_m, &se_top);
-    const double s_u = su.WidthSe(), s_v = sv.WidthSe();
+    const bool averaged = alike.orientations > 1;
+    const double s_u = averaged ? std::max(su.WidthSe(), alike.se_u) : su.WidthSe();
+    const double s_v = averaged ? std::max(sv.WidthSe(), alike.se_v) : sv.WidthSe();
     c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u, se_top};
     return c;
 }
