@@ -87,7 +87,7 @@ std::optional<PolyFit> FitRows(const std::vector<RowReach>& rows, int degree) {
 // Returns the lowest of `rows` (`row_height` apart) that are one wall: the profile ends below
 // the first row that departs from the line through the rows under it by more than a row's
 // height. Between them the surface runs nearer level than upright against that line: a ledge,
-// and the rows above it are another wall (a small box standing on a larger one, an L's step),
+// and the rows above it are another wall (a small parcel standing or strapped on a larger one),
 // which a line through both ran out to the table as far as the ledge is deep. A flank's rows,
 // plane or bending, stay within their noise and curvature of it.
 std::vector<RowReach> OneWall(std::vector<RowReach> rows, double row_height) {

@@ -6,9 +6,9 @@
 // it falls short by the slope times the band's height (a 60 degree flank read 13 mm narrow over a
 // 12 mm band). The principle (enclosing_cuboid.h): what no reading supports is carried by
 // physics into the reach and its bound. Here: the wall's profile just above the band (a line
-// through its lowest rows of cells, up to five) is extended down to the table; the line's
-// uncertainty there, and how far a parabola through the same rows lands from it (a bulging foot
-// keeps bending), go into the standard error.
+// through its lowest rows of cells, up to five, ending below a ledge) is extended down to the
+// table; the line's uncertainty there, and how far a parabola through the same rows lands from
+// it (a bulging foot keeps bending), go into the standard error.
 
 #include "pipeline/envelope/enclosing_cuboid.h"
 #include "pipeline/envelope/surface_cells.h"

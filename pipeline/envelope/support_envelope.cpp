@@ -259,8 +259,9 @@ Result<EnclosingCuboid> CuboidOf(const Surface& surface, const LeastRectangle& r
     }
     EnclosingCuboid c;
     const Eigen::Vector2d u(std::cos(r.phi), std::sin(r.phi)), v(-u.y(), u.x());
-    const double lu = alike.orientations > 1 ? alike.along_u : su.Width();
-    const double lv = alike.orientations > 1 ? alike.along_v : sv.Width();
+    const bool averaged = alike.orientations > 1;
+    const double lu = averaged ? alike.along_u : su.Width();
+    const double lv = averaged ? alike.along_v : sv.Width();
     c.center_m = 0.5 * (su.forward - su.backward) * u + 0.5 * (sv.forward - sv.backward) * v;
     c.length_m = std::max(lu, lv);
     c.width_m = std::min(lu, lv);
@@ -268,7 +269,6 @@ Result<EnclosingCuboid> CuboidOf(const Surface& surface, const LeastRectangle& r
     double se_top = 0.0;
     c.height_m = TopBound(surface.points, sigma, height_sigma, surface.radius, config, &se_top);
     ReadSharpTop(surface, height_sigma, config, &c.height_m, &se_top);
-    const bool averaged = alike.orientations > 1;
     const double s_u = averaged ? std::max(su.WidthSe(), alike.se_u) : su.WidthSe();
     const double s_v = averaged ? std::max(sv.WidthSe(), alike.se_v) : sv.WidthSe();
     c.sigma_m = {lu >= lv ? s_u : s_v, lu >= lv ? s_v : s_u, se_top};
