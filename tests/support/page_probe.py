@@ -135,16 +135,16 @@ def main():
     # The cloud drawn: a canvas with more lit pixels than its background's edges (a "0" from a
     # draw before the canvas had its size is not drawn yet).
     drawn = "+((document.querySelector('#view canvas') || {dataset: {}}).dataset.litPixels || 0) > 500"
-    # The history loaded: its header row is made when the list arrives (the cloud, fetched beside
-    # it, may be drawn first on a loaded machine).
-    drawn += " && document.querySelector('#history-table th') !== null"
+    # And the history loaded: its header row is made when the list arrives (the cloud, fetched
+    # beside it, may be drawn first on a loaded machine).
+    loaded = drawn + " && document.querySelector('#history-table th') !== null"
     for n, step in enumerate(steps):
         result = {"step": step}
         if step[0].isdigit():
             size(browser, step)
             browser.call("Page.navigate", url=url)
             time.sleep(0.3)
-            result["drawn"] = browser.wait_for(drawn)
+            result["loaded"] = browser.wait_for(loaded)
         elif step.startswith("resize:"):
             size(browser, step[len("resize:"):])
             # The ResizeObserver redraws: until the canvas has the view's new size and the cloud

@@ -83,9 +83,11 @@ TEST(FootBand, ALedgeEndsTheWallItsProfileIsReadFrom) {
             EXPECT_FALSE(std::isfinite(
                 ExtrapolateFoot(Layer(stacked, config.min_z_m, 0.1, seed, config), config).reach))
                 << "ledge at " << ledge << ", seed " << seed;
+            // Fewer than three whole rows of the flank below the ledge are no profile to extend.
+            if (ledge < config.min_z_m + 3.0 * config.cell_height_m) continue;
             const FootReach foot =
                 ExtrapolateFoot(Layer(flank, config.min_z_m, 0.1, seed, config), config);
-            if (!std::isfinite(foot.reach)) continue;  // two rows below the ledge: no profile
+            ASSERT_TRUE(std::isfinite(foot.reach)) << "ledge at " << ledge << ", seed " << seed;
             EXPECT_LT(std::abs(foot.reach - 0.060), 2.0 * foot.se + 1e-4)
                 << "ledge at " << ledge << ", seed " << seed;
         }
