@@ -93,8 +93,8 @@ std::optional<PolyFit> FitRows(const std::vector<RowReach>& rows, int degree) {
 std::vector<RowReach> OneWall(std::vector<RowReach> rows, double row_height) {
     for (std::size_t k = 2; k < rows.size(); ++k) {
         const auto below = FitRows(std::vector<RowReach>(rows.begin(), rows.begin() + k), 1);
-        if (below && std::abs(rows[k].s - (below->at_table - below->slope * rows[k].z)) >
-                         row_height) {
+        if (below &&
+            std::abs(rows[k].s - (below->at_table - below->slope * rows[k].z)) > row_height) {
             rows.resize(k);
             break;
         }
@@ -116,9 +116,81 @@ bool NothingReadBelow(const CellGrid<LayerCell>& layer, int first, const Envelop
     return readings < config.min_cell_points;
 }
 
+// Whether `rows` are a flank sloping outward, going down: their line, and the lines above their
+// lowest row and below their highest, slope outward beyond their noise. One row standing out
+// alone is no flank (a silhouette's few stray readings beside an upright tube at its foot), nor
+// one standing in above an upright foot (a ledge's wall). Returns the rows' line where they are.
+std::optional<PolyFit> OutwardLine(const std::vector<RowReach>& rows) {
+    const auto line = FitRows(rows, 1);
+    const auto upper = FitRows(std::vector<RowReach>(rows.begin() + 1, rows.end()), 1);
+    const auto lower = FitRows(std::vector<RowReach>(rows.begin(), rows.end() - 1), 1);
+    const auto outward = [](const std::optional<PolyFit>& f) {
+        return f && f->slope > kSlopeSigmas * f->slope_se;
+    };
+    if (!outward(line) || !outward(upper) || !outward(lower)) return std::nullopt;
+    return line;
+}
+
+// A column's readings of one row within the window about the wall's line: their count, sums of
+// along and up, and of their offsets from the line and its squares.
+struct WindowCell {
+    int n = 0;
+    double along = 0.0, up = 0.0, r = 0.0, rr = 0.0;
+    double Offset() const { return r / n; }
+    double Se() const {
+        const double var = (rr - r * r / n) / std::max(1, n - 1);
+        return std::sqrt(std::max(var, 0.0) / n);
+    }
+};
+
+// The `count` rows from `first` read again (the header's last paragraph): each column's readings
+// of the row within `window` along the direction of `line`, either side; in each row the column
+// standing farthest out of the line, corrected as OutermostInRow corrects its cell. Stops at the
+// first row no column of which holds enough readings.
+std::vector<RowReach> ReadRowsAgain(const CellGrid<LayerCell>& layer, const WallReadings& readings,
+                                    int first, int count, const PolyFit& line, double window,
+                                    const EnvelopeConfig& config) {
+    const int na = layer.na;
+    std::vector<WindowCell> cells(static_cast<std::size_t>(count) * static_cast<std::size_t>(na));
+    for (const Eigen::Vector3d& p : readings.across_up_along) {
+        const int j = static_cast<int>(std::floor((p.y() - layer.b0) / layer.db)) - first;
+        const int i = static_cast<int>(std::floor((readings.sign * p.x() - layer.a0) / layer.da));
+        if (j < 0 || j >= count || i < 0 || i >= na) continue;
+        const double along = readings.sign * p.z();
+        const double r = along - (line.at_table - line.slope * p.y());
+        if (std::abs(r) > window) continue;
+        WindowCell& c = cells[static_cast<std::size_t>(j) * na + i];
+        ++c.n;
+        c.along += along;
+        c.up += p.y();
+        c.r += r;
+        c.rr += r * r;
+    }
+    std::vector<RowReach> rows;
+    for (int j = 0; j < count; ++j) {
+        const WindowCell* row = &cells[static_cast<std::size_t>(j) * na];
+        const WindowCell* best = nullptr;
+        for (int i = 0; i < na; ++i) {
+            const WindowCell& c = row[i];
+            if (c.n >= config.min_cell_points && (!best || c.Offset() > best->Offset())) best = &c;
+        }
+        if (!best) break;
+        int contenders = 0;
+        for (int i = 0; i < na; ++i) {
+            const WindowCell& c = row[i];
+            contenders += c.n >= config.min_cell_points &&
+                          c.Offset() >= best->Offset() - 2.0 * (c.Se() + best->Se());
+        }
+        rows.push_back({best->along / best->n - MedianOfLargest(contenders) * best->Se(),
+                        best->Se(), best->up / best->n});
+    }
+    return rows;
+}
+
 }  // namespace
 
-FootReach ExtrapolateFoot(const CellGrid<LayerCell>& layer, const EnvelopeConfig& config) {
+FootReach ExtrapolateFoot(const CellGrid<LayerCell>& layer, const WallReadings& readings,
+                          double sigma, const EnvelopeConfig& config) {
     FootReach out;
     // The lowest row holding a judged cell: the first above the band, or higher where nothing
     // read the wall's foot (foot_free_space.h says how far it may go).
@@ -141,17 +213,18 @@ FootReach ExtrapolateFoot(const CellGrid<LayerCell>& layer, const EnvelopeConfig
         rows.push_back(*r);
     }
     rows = OneWall(std::move(rows), layer.db);
-    if (rows.size() < 3) return out;
-    const auto line = FitRows(rows, 1);
-    // The profile above its lowest row, and below its highest, must slope outward too: one row
-    // standing out alone is no flank (a silhouette's few stray readings beside an upright tube at
-    // its foot), nor one standing in above an upright foot (a ledge's wall).
-    const auto upper = FitRows(std::vector<RowReach>(rows.begin() + 1, rows.end()), 1);
-    const auto lower = FitRows(std::vector<RowReach>(rows.begin(), rows.end() - 1), 1);
-    const auto outward = [](const std::optional<PolyFit>& f) {
-        return f && f->slope > kSlopeSigmas * f->slope_se;
-    };
-    if (!outward(line) || !outward(upper) || !outward(lower)) return out;
+    if (rows.size() < 3 || !OutwardLine(rows)) return out;
+    // Read again about the line, twice: the first line stands out by the slivers' lean.
+    for (int pass = 0; pass < 2; ++pass) {
+        const PolyFit line = *FitRows(rows, 1);
+        const double window = config.layer_sigmas * sigma * std::hypot(1.0, line.slope);
+        auto again = ReadRowsAgain(layer, readings, first, static_cast<int>(rows.size()), line,
+                                   window, config);
+        if (again.size() != rows.size()) break;
+        rows = std::move(again);
+    }
+    const auto line = OutwardLine(rows);
+    if (!line) return out;
     out.slope = line->slope;
     out.reach = line->at_table;
     double variance = line->at_table_se * line->at_table_se;

@@ -41,11 +41,12 @@ struct Support {
 
 // The outer layers of several grids (cells of `sizes`: along, up), each reading projected once:
 // the layers within config.layer_sigmas sigma of their cells' extremes, and a sloped surface's
-// where that leaves a cell too few readings (sloped_layers.h).
+// where that leaves a cell too few readings (sloped_layers.h). `tzs` gets each reading's
+// (across, up, along).
 std::vector<Layers> BuildLayers(const std::vector<Eigen::Vector3f>& pts, const Eigen::Vector2d& u,
                                 double sigma, double radius, double top,
                                 const std::vector<std::pair<double, double>>& sizes,
-                                const EnvelopeConfig& config) {
+                                const EnvelopeConfig& config, std::vector<Eigen::Vector3d>& tzs) {
     const Eigen::Vector2d v(-u.y(), u.x());
     const std::size_t grids = sizes.size();
     std::vector<Layers> out;
@@ -54,7 +55,7 @@ std::vector<Layers> BuildLayers(const std::vector<Eigen::Vector3f>& pts, const E
                        CellGrid<LayerCell>(-radius, radius, 0.0, top, along, up)});
     }
     // Each reading's (across, up, along), and its cell in each grid (-1: outside it).
-    std::vector<Eigen::Vector3d> tzs(pts.size());
+    tzs.resize(pts.size());
     std::vector<long> cell(pts.size() * grids, -1);
     for (std::size_t i = 0; i < pts.size(); ++i) {
         const Eigen::Vector2d q = pts[i].head<2>().cast<double>();
@@ -108,9 +109,10 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
                      const TableBeside* table) {
     const Eigen::Vector2d u(std::cos(phi), std::sin(phi));
     const double along = config.cell_along_m, height = config.cell_height_m;
-    std::vector<Layers> layers =
-        BuildLayers(pts, u, sigma, radius, top,
-                    {{along, height}, {2.0 * along, 2.0 * height}, {along, height / 2.0}}, config);
+    std::vector<Eigen::Vector3d> tzs;
+    std::vector<Layers> layers = BuildLayers(
+        pts, u, sigma, radius, top,
+        {{along, height}, {2.0 * along, 2.0 * height}, {along, height / 2.0}}, config, tzs);
     Layers &fine = layers[0], &coarse = layers[1], &thin = layers[2];
     for (Layers* l : {&fine, &thin}) {
         MarkSlopesToReadHigh(&l->front, sigma, config);
@@ -135,9 +137,10 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
         farther(fine, std::max(along, height), forward, true, true);
         farther(coarse, 2.0 * std::max(along, height), forward, false, false);
         farther(thin, std::max(along, height / 2.0), forward, true, false);
-        ReachBelow(ExtrapolateFoot(forward ? fine.front : fine.back, config), pts,
-                   forward ? u : Eigen::Vector2d(-u), table, forward ? out.forward : out.backward,
-                   forward ? out.se_forward : out.se_backward,
+        ReachBelow(ExtrapolateFoot(forward ? fine.front : fine.back,
+                                   WallReadings{tzs, forward ? 1.0 : -1.0}, sigma, config),
+                   pts, forward ? u : Eigen::Vector2d(-u), table,
+                   forward ? out.forward : out.backward, forward ? out.se_forward : out.se_backward,
                    forward ? out.open_forward : out.open_backward);
     }
     return out;
@@ -303,10 +306,12 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double he
 
 FootReach FootAlong(const Surface& surface, const Eigen::Vector2d& u, double sigma,
                     const EnvelopeConfig& config) {
-    std::vector<Layers> layers = BuildLayers(surface.points, u, sigma, surface.radius, surface.top,
-                                             {{config.cell_along_m, config.cell_height_m}}, config);
+    std::vector<Eigen::Vector3d> tzs;
+    std::vector<Layers> layers =
+        BuildLayers(surface.points, u, sigma, surface.radius, surface.top,
+                    {{config.cell_along_m, config.cell_height_m}}, config, tzs);
     MarkSlopesToReadHigh(&layers[0].front, sigma, config);
-    return ExtrapolateFoot(layers[0].front, config);
+    return ExtrapolateFoot(layers[0].front, WallReadings{tzs}, sigma, config);
 }
 
 Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, double height_sigma,
