@@ -109,7 +109,7 @@ sanitize_build() {
 
 # Under the sanitizers a test runs 10-20 times slower (the calibration's Ceres problems about 20).
 # `scripts/dev.sh test` (CI) runs under ASan + UBSan each test the plain run before it took at
-# most SANITIZE_MAX_SECONDS (1) over, as its cost file (ctest's) says: 580 of some 650 tests, a
+# most SANITIZE_MAX_SECONDS (1) over, as its cost file (ctest's) says: 566 of 649 tests, a
 # fifth of the time all of them took there. The tests left out repeat the same code over more
 # seeds, larger clouds or a daemon's whole run (the calibration through the CLI, the accuracy
 # suite, the sweeps of L shapes), whose code the quicker tests also pass through. The Debian

@@ -24,24 +24,32 @@ struct RowReach {
     double s = 0.0, se = 0.0, z = 0.0;
 };
 
-std::optional<RowReach> OutermostInRow(const CellGrid<LayerCell>& layer, int row,
-                                       const EnvelopeConfig& config) {
-    const LayerCell* best = nullptr;
-    const auto cell = [&](int i) -> const LayerCell& {
-        return layer.cells[static_cast<std::size_t>(row) * static_cast<std::size_t>(layer.na) +
-                           static_cast<std::size_t>(i)];
-    };
-    for (int i = 0; i < layer.na; ++i) {
-        const LayerCell& c = cell(i);
-        if (c.n >= config.min_cell_points && (!best || c.Mean() > best->Mean())) best = &c;
+// The outermost of a row's `na` cells holding at least `min_points` readings, by `reach`, and how
+// many cells compete for it: those within two standard errors (`se`) of it.
+template <class Cell, class Reach, class Se>
+std::optional<std::pair<const Cell*, int>> Outermost(const Cell* row, int na, int min_points,
+                                                     Reach reach, Se se) {
+    const Cell* best = nullptr;
+    for (int i = 0; i < na; ++i) {
+        if (row[i].n >= min_points && (!best || reach(row[i]) > reach(*best))) best = &row[i];
     }
     if (!best) return std::nullopt;
     int contenders = 0;
-    for (int i = 0; i < layer.na; ++i) {
-        const LayerCell& c = cell(i);
-        contenders += c.n >= config.min_cell_points &&
-                      c.Mean() >= best->Mean() - 2.0 * (c.StdError() + best->StdError());
+    for (int i = 0; i < na; ++i) {
+        contenders += row[i].n >= min_points &&
+                      reach(row[i]) >= reach(*best) - 2.0 * (se(row[i]) + se(*best));
     }
+    return std::pair{best, contenders};
+}
+
+std::optional<RowReach> OutermostInRow(const CellGrid<LayerCell>& layer, int row,
+                                       const EnvelopeConfig& config) {
+    const auto outermost = Outermost(
+        &layer.cells[static_cast<std::size_t>(row) * static_cast<std::size_t>(layer.na)], layer.na,
+        config.min_cell_points, [](const LayerCell& c) { return c.Mean(); },
+        [](const LayerCell& c) { return c.StdError(); });
+    if (!outermost) return std::nullopt;
+    const auto [best, contenders] = *outermost;
     return RowReach{best->Mean() - MedianOfLargest(contenders) * best->StdError(), best->StdError(),
                     best->Centroid().y()};
 }
@@ -168,19 +176,12 @@ std::vector<RowReach> ReadRowsAgain(const CellGrid<LayerCell>& layer, const Wall
     }
     std::vector<RowReach> rows;
     for (int j = 0; j < count; ++j) {
-        const WindowCell* row = &cells[static_cast<std::size_t>(j) * na];
-        const WindowCell* best = nullptr;
-        for (int i = 0; i < na; ++i) {
-            const WindowCell& c = row[i];
-            if (c.n >= config.min_cell_points && (!best || c.Offset() > best->Offset())) best = &c;
-        }
-        if (!best) break;
-        int contenders = 0;
-        for (int i = 0; i < na; ++i) {
-            const WindowCell& c = row[i];
-            contenders += c.n >= config.min_cell_points &&
-                          c.Offset() >= best->Offset() - 2.0 * (c.Se() + best->Se());
-        }
+        const auto outermost = Outermost(
+            &cells[static_cast<std::size_t>(j) * na], na, config.min_cell_points,
+            [](const WindowCell& c) { return c.Offset(); },
+            [](const WindowCell& c) { return c.Se(); });
+        if (!outermost) break;
+        const auto [best, contenders] = *outermost;
         rows.push_back({best->along / best->n - MedianOfLargest(contenders) * best->Se(),
                         best->Se(), best->up / best->n});
     }
