@@ -33,7 +33,10 @@
 //     the bend of its profile in the bound; an upright wall stays where it is (foot_band.h);
 //   - a wall's foot that nothing read (a dark or glossy base, a shadow): the table's readings
 //     beside the object bound how far it may go, the wall's extrapolation is held within that
-//     and the bound reaches it; with no table reading beyond, refused (foot_free_space.h);
+//     and the bound reaches it, and back to the readings where the table was read where the
+//     wall would have gone on; with no table reading beyond, refused (foot_free_space.h). What
+//     no reading supports on a width's two sides is added, not taken as independent noise: one
+//     object's flanks turn alike under their lowest readings (SideReach);
 //   - a side no view faced: refused (support_envelope.cpp), or for one view assumed and tested
 //     (single_view_cuboid.h);
 //   - a top no view saw from above: the walls' ends, with their noise (HeightNoiseSigma).

@@ -72,34 +72,39 @@ double FreeReach(const TableBeside& table, const std::vector<Eigen::Vector3f>& o
 }
 
 void ReachBelow(const FootReach& foot, const std::vector<Eigen::Vector3f>& pts,
-                const Eigen::Vector2d& u, const TableBeside* table, double& reach, double& se,
-                bool& open) {
+                const Eigen::Vector2d& u, const TableBeside* table, SideReach& side) {
     if (!foot.raised) {
-        if (foot.reach > reach) {
-            reach = foot.reach;
-            se = foot.se;
+        if (foot.reach > side.reach) {
+            side.reach = foot.reach;
+            side.se = foot.se;
         }
         // Sparse readings below the lowest judged row do not say where the wall ends: the
         // bound reaches the free table beyond.
         const double free =
             foot.above_band && table != nullptr ? FreeReach(*table, pts, u) : -INFINITY;
-        if (std::isfinite(free) && free > reach) se = std::max(se, (free - reach) / kNormal95);
+        if (std::isfinite(free) && free > side.reach) side.unseen = (free - side.reach) / kNormal95;
         return;
     }
     if (table == nullptr) return;
     const double free = FreeReach(*table, pts, u);
     if (!std::isfinite(free)) {
-        open = true;
+        side.open = true;
         return;
     }
     // The readings hold the reach from below and the table from above; within that, a wall
     // sloping outward goes on sloping. The bound reaches the table's limit, and below as far as
-    // the extrapolation's own error or the readings, whichever is nearer.
-    const double read = reach;
+    // the extrapolation's own error or the readings, whichever is nearer. Where the table was
+    // read where the wall would have gone on to, it did not: it turned in somewhere between its
+    // lowest readings and the table (a sack's bulge over a narrower foot), and where is unseen.
+    const double read = side.reach;
     if (free <= read) return;
-    reach = std::clamp(foot.reach, read, free);
-    const double below = std::min(reach - read, kNormal95 * foot.se);
-    se = std::max(se, std::max(free - reach, below) / kNormal95);
+    side.reach = std::clamp(foot.reach, read, free);
+    if (foot.reach > free) {
+        side.unseen = (free - read) / kNormal95;
+        return;
+    }
+    side.se = std::max(side.se, std::min(side.reach - read, kNormal95 * foot.se) / kNormal95);
+    side.unseen = (free - side.reach) / kNormal95;
 }
 
 TableBeside TableBesideOf(const Surface& surface, double sigma, const EnvelopeConfig& config) {

@@ -42,16 +42,28 @@ double TableReadingSpread(double sigma_m, const std::vector<Eigen::Vector3f>& ca
 double FreeReach(const TableBeside& table, const std::vector<Eigen::Vector3f>& object,
                  const Eigen::Vector2d& u);
 
+// A side's reach in one direction: where its outer layer ends, the standard error of that from
+// the readings' noise (`se`), and the standard error of what no reading supports there
+// (`unseen`: a foot band or a foot nothing read, up to where the table was seen). The unseen part
+// is no noise that the two sides of a width draw apart: one object's flanks bend alike under
+// their lowest readings (a sack's bulge turns in on both sides, a dark base hides both feet), so
+// a width adds its sides' unseen parts before taking them with their noise (Support::WidthSe).
+struct SideReach {
+    double reach = -INFINITY;
+    double se = 0.0;
+    double unseen = 0.0;
+    bool open = false;  // a foot nothing read and no table reading beyond bounds
+};
+
 // Below the lowest row (`foot`, along `u`): a wall sloping outward goes on to the table
 // (foot_band.h). Where nothing read the foot (its lowest readings stand above the band), the
 // table's readings beside the object bound how far it may go (foot_free_space.h): the
 // extrapolation is held within that, and the 95% bound reaches that limit (the object may
 // continue into what nothing read, up to where the table was seen) as well as covering the
-// extrapolation's own error; with no table readings beyond, the foot is open. Without the
-// table's readings (`table` null) a raised foot stays where its readings are.
+// extrapolation's own error, as `side`'s unseen part; with no table readings beyond, the foot is
+// open. Without the table's readings (`table` null) a raised foot stays where its readings are.
 void ReachBelow(const FootReach& foot, const std::vector<Eigen::Vector3f>& pts,
-                const Eigen::Vector2d& u, const TableBeside* table, double& reach, double& se,
-                bool& open);
+                const Eigen::Vector2d& u, const TableBeside* table, SideReach& side);
 
 // Returns the table beside `surface` as FreeReach reads it (1.5 spreads of a table reading's
 // noise along the top for `sigma` about its plane, strips a quarter of a cell wide), or one with

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "pipeline/core/parallel_for.h"
+#include "pipeline/envelope/alike_rectangles.h"
 #include "pipeline/envelope/foot_band.h"
 #include "pipeline/envelope/foot_free_space.h"
 #include "pipeline/envelope/layer_marks.h"
@@ -31,12 +32,12 @@ constexpr double kUnseenShare = 0.1;
 // The outer layer's largest bound in direction (cos φ, sin φ) and in the opposite one, over
 // cells of (position across the direction, height).
 struct Support {
-    double forward = -INFINITY, backward = -INFINITY;
-    double se_forward = 0.0, se_backward = 0.0;
-    // A foot nothing read, and no table reading beside it bounds (foot_free_space.h).
-    bool open_forward = false, open_backward = false;
-    double Width() const { return forward + backward; }
-    double WidthSe() const { return std::hypot(se_forward, se_backward); }
+    SideReach forward, backward;
+    double Width() const { return forward.reach + backward.reach; }
+    // The sides' noise apart, what nothing read on them together (SideReach).
+    double WidthSe() const {
+        return std::hypot(forward.se, backward.se, forward.unseen + backward.unseen);
+    }
 };
 
 // The outer layers of several grids (cells of `sizes`: along, up), each reading projected once:
@@ -127,10 +128,10 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
         const auto& cells = forward ? layers.front.cells : layers.back.cells;
         const double bound =
             LargestBound(cells, config, sigma, sigma, extent, &se, &judged, walls, caps);
-        double& best = forward ? out.forward : out.backward;
-        if (bound > best) {
-            best = bound;
-            (forward ? out.se_forward : out.se_backward) = se;
+        SideReach& side = forward ? out.forward : out.backward;
+        if (bound > side.reach) {
+            side.reach = bound;
+            side.se = se;
         }
     };
     for (bool forward : {true, false}) {
@@ -140,85 +141,9 @@ Support SupportAlong(const std::vector<Eigen::Vector3f>& pts, double phi, double
         ReachBelow(ExtrapolateFoot(forward ? fine.front : fine.back,
                                    WallReadings{tzs, forward ? 1.0 : -1.0}, sigma, config),
                    pts, forward ? u : Eigen::Vector2d(-u), table,
-                   forward ? out.forward : out.backward, forward ? out.se_forward : out.se_backward,
-                   forward ? out.open_forward : out.open_backward);
+                   forward ? out.forward : out.backward);
     }
     return out;
-}
-
-// The rectangles no worse than the least one by more than their noise, their sides averaged,
-// where the least one has no direction of its own. The least area over many directions is the
-// least of that many noisy areas: where the object's rectangle hardly changes with its
-// direction (a standing tube, a round bag), it is the direction whose supports the noise made
-// smallest, and a tube's diameter read half a millimetre small. Where the object has a
-// direction (a box, an L), the area grows away from it by the sum of its sides squared per
-// radian, so the rectangles alike lie within 2 sigma_A / (lu² + lv²) of it, a step either way
-// at most; those are wider by the other side times the turn, which a noisy area may not show,
-// and the least rectangle stands alone. It also stands alone where the areas grow away from it
-// at half that rate or more, their slope over the turn fitted over kTurnSteps directions either
-// way: an object whose footprint has corners. A direction's sigma_A is its chosen cells', and
-// on a noisy cloud a wall's end read above its readings' mean (HighEndSe) made it several
-// millimetres: areas two steps from an L's corner passed for alike, and its turned rectangles
-// read it 4 mm long. A rounded footprint (a bag, a tube) grows far slower than its corners'
-// rate near its least rectangle.
-struct Alike {
-    int orientations = 1;
-    double along_u = 0.0, along_v = 0.0;  // mean sides along the least rectangle's u and v
-    // Their mean standard errors: neighbouring directions share their readings, so the mean of
-    // the sides is known no better than they are (a side reached out by an uncertain foot is
-    // alike by its wide error, and its reach counts in the mean).
-    double se_u = 0.0, se_v = 0.0;
-};
-
-Alike AlikeRectangles(const std::vector<Support>& supports, int best) {
-    const int n = static_cast<int>(supports.size());
-    auto sides = [&](int i) {
-        const Support &a = supports[static_cast<std::size_t>(i % n)],
-                      &b = supports[static_cast<std::size_t>((i + n / 2) % n)];
-        return std::array<double, 4>{a.Width(), b.Width(), a.WidthSe(), b.WidthSe()};
-    };
-    auto area = [](const std::array<double, 4>& s) { return s[0] * s[1]; };
-    auto area_se = [](const std::array<double, 4>& s) {
-        return std::hypot(s[1] * s[2], s[0] * s[3]);
-    };
-    const auto least = sides(best);
-    const double step = M_PI / n;
-    const double faceted = 2.0 * area_se(least) / (least[0] * least[0] + least[1] * least[1]);
-    double sum_u = 0.0, sum_v = 0.0, sum_se_u = 0.0, sum_se_v = 0.0, widest = 0.0;
-    int count = 0;
-    for (int i = 0; i < n / 2; ++i) {
-        const auto s = sides(i);
-        if (area(s) - area(least) > 2.0 * std::hypot(area_se(s), area_se(least))) continue;
-        // Sides paired with the least rectangle's: i's first side lies along u when i is within
-        // a quarter turn of it.
-        const int turn = ((i - best) % n + n) % n;
-        const bool same = turn < n / 4 || turn >= 3 * n / 4;
-        const int off = turn % (n / 2);
-        widest = std::max(widest, step * std::min(off, n / 2 - off));
-        sum_u += same ? s[0] : s[1];
-        sum_v += same ? s[1] : s[0];
-        sum_se_u += same ? s[2] : s[3];
-        sum_se_v += same ? s[3] : s[2];
-        ++count;
-    }
-    if (widest <= faceted + step) return {};
-    // The areas' growth per step away from the least, by least squares over the turn.
-    constexpr int kTurnSteps = 10;
-    double st = 0.0, sa = 0.0, stt = 0.0, sta = 0.0;
-    int points = 0;
-    for (int k = 1; k <= std::min(kTurnSteps, n / 4); ++k) {
-        for (int side : {-1, 1}) {
-            const double a = area(sides(((best + side * k) % n + n) % n)) - area(least);
-            st += k;
-            sa += a;
-            stt += k * k;
-            sta += k * a;
-            ++points;
-        }
-    }
-    const double growth = (sta - st * sa / points) / (stt - st * st / points);
-    if (growth >= 0.5 * (least[0] * least[0] + least[1] * least[1]) * step) return {};
-    return {count, sum_u / count, sum_v / count, sum_se_u / count, sum_se_v / count};
 }
 
 // An unseen side leaves the object unbounded there: a bulge or a flap could stand out
@@ -246,8 +171,8 @@ struct LeastRectangle {
     double phi = 0.0, area = INFINITY;
 };
 
-// The enclosing cuboid of the least rectangle `r` (the `alike` rectangles' mean sides where
-// several are alike) and the top's height; refused where a side was never seen or its foot is
+// The enclosing cuboid of the least rectangle `r` (the `alike` rectangles' sides where several
+// are alike) and the top's height; refused where a side was never seen or its foot is
 // open (foot_free_space.h).
 Result<EnclosingCuboid> CuboidOf(const Surface& surface, const LeastRectangle& r,
                                  const Alike& alike, double sigma, double height_sigma,
@@ -257,7 +182,7 @@ Result<EnclosingCuboid> CuboidOf(const Surface& surface, const LeastRectangle& r
         return Error{ErrorCode::kInsufficientData,
                      "a side of the object was never seen: too few views around it to bound it"};
     }
-    if (su.open_forward || su.open_backward || sv.open_forward || sv.open_backward) {
+    if (su.forward.open || su.backward.open || sv.forward.open || sv.backward.open) {
         return FootUnreadRefusal();
     }
     EnclosingCuboid c;
@@ -265,10 +190,14 @@ Result<EnclosingCuboid> CuboidOf(const Surface& surface, const LeastRectangle& r
     const bool averaged = alike.orientations > 1;
     const double lu = averaged ? alike.along_u : su.Width();
     const double lv = averaged ? alike.along_v : sv.Width();
-    c.center_m = 0.5 * (su.forward - su.backward) * u + 0.5 * (sv.forward - sv.backward) * v;
+    c.center_m = 0.5 * (su.forward.reach - su.backward.reach) * u +
+                 0.5 * (sv.forward.reach - sv.backward.reach) * v;
     c.length_m = std::max(lu, lv);
     c.width_m = std::min(lu, lv);
-    c.length_axis = lu >= lv ? u : v;
+    // The sides' own direction, where the alike rectangles' sides were read turned from the least.
+    const double phi = r.phi + (averaged ? alike.turn : 0.0);
+    const Eigen::Vector2d axis(std::cos(phi), std::sin(phi));
+    c.length_axis = lu >= lv ? axis : Eigen::Vector2d(-axis.y(), axis.x());
     double se_top = 0.0;
     c.height_m = TopBound(surface.points, sigma, height_sigma, surface.radius, config, &se_top);
     ReadSharpTop(surface, height_sigma, config, &c.height_m, &se_top);
@@ -350,7 +279,8 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
             reach_b = std::max(reach_b, -d);
         }
         const double slack = kUnseenShare * (reach_f + reach_b);
-        const bool short_f = s->forward < reach_f - slack, short_b = s->backward < reach_b - slack;
+        const bool short_f = s->forward.reach < reach_f - slack,
+                   short_b = s->backward.reach < reach_b - slack;
         if (!short_f && !short_b) return s->Width();
         const Eigen::Vector2d ud(std::cos(phi), std::sin(phi));
         if (unseen && ((short_f && !faced(ud)) || (short_b && !faced(-ud)))) *unseen = 1;
@@ -371,7 +301,9 @@ Result<EnclosingCuboid> EnvelopeCuboid(const Surface& surface, double sigma, dou
     }
     LeastRectangle r{coarse[best], coarse[(best + n / 2) % n], M_PI * best / n,
                      w[best] * w[(best + n / 2) % n]};
-    const auto alike = AlikeRectangles(coarse, best);
+    std::vector<double> w_se(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i) w_se[i] = coarse[i].WidthSe();
+    const auto alike = AlikeRectangles(w, w_se, best);
     if (alike.orientations == 1) {
         // Tenths of a step either way, each direction and the one square to it.
         constexpr int kFine = 9;

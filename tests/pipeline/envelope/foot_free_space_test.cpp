@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "pipeline/core/student_t.h"
 #include "pipeline/envelope/support_envelope.h"
 
 namespace boxd::envelope {
@@ -96,9 +97,12 @@ TEST(FootFreeSpace, ATableReadingSpreadsAlongTheTopAsItsRayFallsFlat) {
 
 // A prism 300 mm long lying on a face (120 mm base, 100 mm tall) whose lowest 30 mm read
 // nothing (a dark base) but `strays` mixed pixels scattered over the dark flanks, 8 cameras
-// round it, and the table read beside it (or not at all).
-Surface DarkFootedPrism(bool table_read, unsigned seed, int strays = 0) {
-    constexpr double kLength = 0.3, kHalfBase = 0.06, kHeight = 0.1, kDark = 0.03;
+// round it, and the table read beside it (or not at all). Where its flanks `turn_in` under their
+// lowest readings (a sack's bulge over a narrower foot), the table is read from there on, and the
+// readings end just above a row's foot (36.5 mm: a row read in part is read at its foot).
+Surface DarkFootedPrism(bool table_read, unsigned seed, int strays = 0, bool turn_in = false) {
+    constexpr double kLength = 0.3, kHalfBase = 0.06, kHeight = 0.1;
+    const double kDark = turn_in ? 0.0365 : 0.03;
     std::mt19937 rng(seed);
     std::normal_distribution<double> noise(0.0, 0.001);
     auto half_width = [&](double z) { return kHalfBase * (1.0 - z / kHeight); };
@@ -135,7 +139,8 @@ Surface DarkFootedPrism(bool table_read, unsigned seed, int strays = 0) {
     if (table_read) {
         for (double x = -0.25; x <= 0.25; x += 0.002) {
             for (double y = -0.15; y <= 0.15; y += 0.002) {
-                if (std::abs(x) <= kLength / 2 && std::abs(y) <= kHalfBase) continue;
+                const double foot = turn_in ? half_width(kDark) : kHalfBase;
+                if (std::abs(x) <= kLength / 2 && std::abs(y) <= foot) continue;
                 // The table's readings spread 1.3 mm along the top (rays at 41 degrees).
                 s.table.emplace_back(static_cast<float>(x + 1.3 * noise(rng)),
                                      static_cast<float>(y + 1.3 * noise(rng)));
@@ -154,9 +159,26 @@ TEST(FootFreeSpace, ADarkFootIsBoundedByTheTableBesideIt) {
         // Its readings stop 18 mm short of the foot each side (120 mm read as 84 mm before).
         EXPECT_LT(std::abs(c->width_m - 0.12), 2.0 * c->sigma_m[1] + 0.001) << "seed " << seed;
         EXPECT_LT(std::abs(c->length_m - 0.3), 2.0 * c->sigma_m[0] + 0.001) << "seed " << seed;
-        // What the readings alone miss (36 mm) is carried, not hidden: the 95% bound covers the
-        // extrapolation's error over 30 mm and the table's sparser readings (2 mm apart).
-        EXPECT_LT(c->sigma_m[1], 0.01) << "seed " << seed;
+        // What the readings alone miss (36 mm) is carried, not hidden, and no more: the 95%
+        // bound covers the extrapolation's error over 30 mm and the free table beyond each foot,
+        // both feet at once (SideReach), which the table's readings, 2 mm apart and spread
+        // 1.3 mm, leave open to at most 14 mm past it in the least read strip.
+        EXPECT_LT(kNormal95 * c->sigma_m[1], 2.0 * 0.014) << "seed " << seed;
+    }
+}
+
+TEST(FootFreeSpace, BothFeetMayTurnInUnderTheirLowestReadingsAtOnce) {
+    // The same flanks, standing on a foot no wider than their lowest readings (76.2 mm): the
+    // extrapolation runs out past the free table on both sides, and the bound reaches back to
+    // the readings on both at once, to within their own noise (1 mm, three sigmas a side). The
+    // two sides taken as independent noise, and the extrapolation's own error for the rest,
+    // reached 92-93 mm of a width read 96-98 mm.
+    for (unsigned seed = 1; seed <= 3; ++seed) {
+        const auto c =
+            EnvelopeCuboid(DarkFootedPrism(true, seed, 0, true), 0.001, 0.001, EnvelopeConfig{});
+        ASSERT_TRUE(c.ok()) << c.error().message;
+        EXPECT_GT(c->width_m, 0.0762) << "seed " << seed;
+        EXPECT_LT(c->width_m - kNormal95 * c->sigma_m[1], 0.0762 + 2.0 * 0.003) << "seed " << seed;
     }
 }
 
