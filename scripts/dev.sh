@@ -15,7 +15,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 PACKAGES=(
-    build-essential cmake pkg-config git ca-certificates
+    build-essential cmake ninja-build pkg-config git ca-certificates
     libeigen3-dev libpcl-dev libopencv-dev libceres-dev
     libmodbus-dev libopenni2-dev libfreenect-dev libusb-1.0-0-dev
     libyaml-cpp-dev nlohmann-json3-dev libcpp-httplib-dev libcli11-dev libspdlog-dev
@@ -44,16 +44,25 @@ deps() {
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y --no-install-recommends "${PACKAGES[@]}"
 }
 
+# Ninja compiles a target's files while the libraries they link are still being archived, where
+# make's recursive passes wait for each target whole (one core idle at the end of each library).
+GENERATOR=${BOXD_GENERATOR:-Ninja}
+
 # Configures `dir` with the given options unless it already is: configuring a configured tree
 # again reorders PCL's include directories, which rebuilds everything. (cmake --build still
-# reconfigures by itself when a CMakeLists.txt changes.)
+# reconfigures by itself when a CMakeLists.txt changes.) A tree another generator made is
+# configured afresh: cmake will not switch one in place.
 configure() {
-    local dir=$1 stamp=$2
+    local dir=$1 stamp="$2 $GENERATOR"
     shift 2
     if [ -f "$dir/CMakeCache.txt" ] && [ "$(cat "$dir/.dev-configured" 2>/dev/null)" = "$stamp" ]; then
         return
     fi
-    cmake -S . -B "$dir" "$@"
+    if [ -f "$dir/CMakeCache.txt" ] &&
+        ! grep -qx "CMAKE_GENERATOR:INTERNAL=$GENERATOR" "$dir/CMakeCache.txt"; then
+        rm -rf "$dir/CMakeCache.txt" "$dir/CMakeFiles"
+    fi
+    cmake -S . -B "$dir" -G "$GENERATOR" "$@"
     echo "$stamp" > "$dir/.dev-configured"
 }
 
