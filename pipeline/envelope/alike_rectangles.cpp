@@ -29,9 +29,9 @@ Parabolas FitParabolas(const std::vector<Turned>& alike) {
     Eigen::MatrixXd a(n, 3);
     Eigen::MatrixXd y(n, 3);
     for (int k = 0; k < n; ++k) {
-        const double t = alike[static_cast<std::size_t>(k)].turn;
-        a.row(k) << 1.0, t, t * t;
-        y.row(k) << alike[k].area, alike[k].u, alike[k].v;
+        const Turned& r = alike[static_cast<std::size_t>(k)];
+        a.row(k) << 1.0, r.turn, r.turn * r.turn;
+        y.row(k) << r.area, r.u, r.v;
     }
     const Eigen::Matrix3d normal = a.transpose() * a;
     const Eigen::LDLT<Eigen::Matrix3d> ldlt(normal);
