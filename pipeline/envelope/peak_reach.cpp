@@ -62,21 +62,55 @@ double ViewSpacing(const std::vector<Eigen::Vector3f>& top,
     return spacings.empty() ? 0.0 : Median(spacings);
 }
 
+// How far `p` lies from the apex point `apex`, or across the ridge line through it where
+// `across` (the unit vector across the ridge) is given.
+double Away(const Eigen::Vector3f& p, const Eigen::Vector2d& apex, const Eigen::Vector2d* across) {
+    const Eigen::Vector2d q = p.head<2>().cast<double>() - apex;
+    return across ? std::abs(across->dot(q)) : q.norm();
+}
+
+// The top's drop per metre away from it, the inverse reading of FlankSlope's: the readings out
+// to `reach` from the apex point (or across the ridge line) in kDropBins bins of that distance,
+// each bin's median drop below `highest`, a line through (distance, drop) by least squares.
+// Infinite where fewer than three bins hold kBinReadings readings (it cannot tell).
+double DropSlope(const std::vector<Eigen::Vector3f>& top, const Eigen::Vector2d& apex,
+                 const Eigen::Vector2d* across, double highest, double reach) {
+    std::vector<std::vector<double>> bins(kDropBins);
+    for (const Eigen::Vector3f& p : top) {
+        const int bin = static_cast<int>(Away(p, apex, across) / reach * kDropBins);
+        if (bin >= 0 && bin < kDropBins)
+            bins[static_cast<std::size_t>(bin)].push_back(highest - p.z());
+    }
+    double n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
+    for (int b = 0; b < kDropBins; ++b) {
+        if (bins[static_cast<std::size_t>(b)].size() < kBinReadings) continue;
+        const double x = (b + 0.5) * reach / kDropBins,
+                     y = Median(bins[static_cast<std::size_t>(b)]);
+        n += 1.0;
+        sx += x;
+        sy += y;
+        sxx += x * x;
+        sxy += x * y;
+    }
+    const double det = n * sxx - sx * sx;
+    if (n < 3.0 || !(det > 0.0)) return INFINITY;
+    return (n * sxy - sx * sy) / det;
+}
+
 // The flanks' slope from how the top widens going down: the readings in kDropBins bins of
 // their drop below `highest`, each bin's median distance from the apex point (or across the
 // ridge line), a line through (drop, distance) by least squares: a flank rising s metres per
 // metre runs 1/s metre out per metre down. A top already `narrow_m` wide where it is highest
-// (a face), one that does not widen (a panel's edge, its width its thickness), or widens as a
-// smooth crown does, has none.
+// (a face), one that does not widen (a panel's edge, its width its thickness), widens as a
+// smooth crown does, or is flat where it is highest (DropSlope), has none.
 std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top,
                                  const Eigen::Vector2d& apex, const Eigen::Vector2d* across,
                                  double highest, double band_m, double narrow_m) {
     std::vector<std::vector<double>> bins(kDropBins);
     for (const Eigen::Vector3f& p : top) {
-        const Eigen::Vector2d q = p.head<2>().cast<double>() - apex;
         const int bin = static_cast<int>((highest - p.z()) / band_m * kDropBins);
         if (bin < 0 || bin >= kDropBins) continue;
-        bins[static_cast<std::size_t>(bin)].push_back(across ? std::abs(across->dot(q)) : q.norm());
+        bins[static_cast<std::size_t>(bin)].push_back(Away(p, apex, across));
     }
     std::vector<double> x, y;
     for (int b = 0; b < kDropBins; ++b) {
@@ -110,6 +144,14 @@ std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top,
     // A top as wide as a cell where it is highest is a face, not a point or a line.
     if (!(at_top <= narrow_m)) return std::nullopt;
     if (!(run > 0.0) || !(1.0 / run > kMinSlope) || 1.0 / run > kMaxSlope) return std::nullopt;
+    // Read the other way, over the inner half of the distance at which the flanks would hold the
+    // band's lowest readings, a sharp top's readings drop away from it at once. A top flat where
+    // it is highest, whose readings widen only below it (a strap's bar 25 mm wide, the mixed
+    // pixels along its edges), keeps its highest readings across it: its top is read, and no
+    // apex stands above them (a handle read 8 mm tall within an 8 mm bound).
+    if (!(DropSlope(top, apex, across, highest, (at_top + run * band_m) / 2.0) > kMinSlope)) {
+        return std::nullopt;
+    }
     return 1.0 / run;
 }
 

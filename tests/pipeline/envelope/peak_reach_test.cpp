@@ -1,7 +1,7 @@
 // Known-answer tests of a sharp top (pipeline/envelope/peak_reach.h): a pyramid whose last
 // millimetres no view read, a prism's ridge, and tops that are not sharp — a flat top, a bag's
-// gentle crown, an upright panel's edge — each read by 18 views on their own jittered 2 mm grids
-// with 1 mm of noise in height.
+// gentle crown, an upright panel's edge, a strap's flat bar — each read by 18 views on their own
+// jittered 2 mm grids with 1 mm of noise in height.
 #include "pipeline/envelope/peak_reach.h"
 
 #include <gtest/gtest.h>
@@ -117,6 +117,19 @@ TEST(PeakReach, FlatTopsGentleCrownsAndPanelEdgesAreNotSharp) {
         EXPECT_FALSE(Peak(Sample(flat, 0.1, 1.0, seed)).sharp) << "seed " << seed;
         EXPECT_FALSE(Peak(Sample(crown, 0.1, 1.0, seed)).sharp) << "seed " << seed;
         EXPECT_FALSE(Peak(Sample(panel, 0.1, 1.0, seed)).sharp) << "seed " << seed;
+    }
+}
+
+// A carrying strap's bar, 25 mm wide and flat on top, along x: its readings widen below it as
+// flanks would (the mixed pixels along its edges, read along the rays to the carton's top far
+// below, fall 5 mm per millimetre out), but its top is read across its whole width.
+TEST(PeakReach, AStrapsFlatBarWidenedBelowByMixedPixelsIsNotSharp) {
+    auto bar = [](double, double y) {
+        const double out = std::abs(y) - 0.0125;
+        return out <= 0.0 ? 0.2 : out < 0.005 ? 0.2 - 5.0 * out : double{NAN};
+    };
+    for (unsigned seed = 1; seed <= 3; ++seed) {
+        EXPECT_FALSE(Peak(Sample(bar, 0.05, 1.0, seed)).sharp) << "seed " << seed;
     }
 }
 
