@@ -69,32 +69,15 @@ double Away(const Eigen::Vector3f& p, const Eigen::Vector2d& apex, const Eigen::
     return across ? std::abs(across->dot(q)) : q.norm();
 }
 
-// The top's drop per metre away from it, the inverse reading of FlankSlope's: the readings out
-// to `reach` from the apex point (or across the ridge line) in kDropBins bins of that distance,
-// each bin's median drop below `highest`, a line through (distance, drop) by least squares.
-// Infinite where fewer than three bins hold kBinReadings readings (it cannot tell).
-double DropSlope(const std::vector<Eigen::Vector3f>& top, const Eigen::Vector2d& apex,
-                 const Eigen::Vector2d* across, double highest, double reach) {
-    std::vector<std::vector<double>> bins(kDropBins);
+// The median drop below `highest` of the top's readings within `reach` of the apex point (or
+// across the ridge line); infinite for fewer than kFlankReadings of them (it cannot tell).
+double MedianDrop(const std::vector<Eigen::Vector3f>& top, const Eigen::Vector2d& apex,
+                  const Eigen::Vector2d* across, double highest, double reach) {
+    std::vector<double> drops;
     for (const Eigen::Vector3f& p : top) {
-        const int bin = static_cast<int>(Away(p, apex, across) / reach * kDropBins);
-        if (bin >= 0 && bin < kDropBins)
-            bins[static_cast<std::size_t>(bin)].push_back(highest - p.z());
+        if (Away(p, apex, across) < reach) drops.push_back(highest - p.z());
     }
-    double n = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0;
-    for (int b = 0; b < kDropBins; ++b) {
-        if (bins[static_cast<std::size_t>(b)].size() < kBinReadings) continue;
-        const double x = (b + 0.5) * reach / kDropBins,
-                     y = Median(bins[static_cast<std::size_t>(b)]);
-        n += 1.0;
-        sx += x;
-        sy += y;
-        sxx += x * x;
-        sxy += x * y;
-    }
-    const double det = n * sxx - sx * sx;
-    if (n < 3.0 || !(det > 0.0)) return INFINITY;
-    return (n * sxy - sx * sy) / det;
+    return drops.size() < kFlankReadings ? INFINITY : Median(std::move(drops));
 }
 
 // The flanks' slope from how the top widens going down: the readings in kDropBins bins of
@@ -102,10 +85,12 @@ double DropSlope(const std::vector<Eigen::Vector3f>& top, const Eigen::Vector2d&
 // ridge line), a line through (drop, distance) by least squares: a flank rising s metres per
 // metre runs 1/s metre out per metre down. A top already `narrow_m` wide where it is highest
 // (a face), one that does not widen (a panel's edge, its width its thickness), widens as a
-// smooth crown does, or is flat where it is highest (DropSlope), has none.
+// smooth crown does, or is flat where it is highest (its readings there within twice
+// `noise_sigma`, a reading's noise in its height, of the highest), has none.
 std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top,
                                  const Eigen::Vector2d& apex, const Eigen::Vector2d* across,
-                                 double highest, double band_m, double narrow_m) {
+                                 double highest, double band_m, double narrow_m,
+                                 double noise_sigma) {
     std::vector<std::vector<double>> bins(kDropBins);
     for (const Eigen::Vector3f& p : top) {
         const int bin = static_cast<int>((highest - p.z()) / band_m * kDropBins);
@@ -144,12 +129,14 @@ std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top,
     // A top as wide as a cell where it is highest is a face, not a point or a line.
     if (!(at_top <= narrow_m)) return std::nullopt;
     if (!(run > 0.0) || !(1.0 / run > kMinSlope) || 1.0 / run > kMaxSlope) return std::nullopt;
-    // Read the other way, over the inner half of the distance at which the flanks would hold the
-    // band's lowest readings, a sharp top's readings drop away from it at once. A top flat where
+    // A sharp top is a point or a line: the readings nearest it, within half the distance at
+    // which the flanks would hold the band's lowest readings, lie mostly on the flanks below it
+    // (a pyramid's, smeared along their rays, a median 10 mm below the highest). A top flat where
     // it is highest, whose readings widen only below it (a strap's bar 25 mm wide, the mixed
-    // pixels along its edges), keeps its highest readings across it: its top is read, and no
-    // apex stands above them (a handle read 8 mm tall within an 8 mm bound).
-    if (!(DropSlope(top, apex, across, highest, (at_top + run * band_m) / 2.0) > kMinSlope)) {
+    // pixels along its edges), keeps them at its height, within the noise: its top is read, and
+    // no apex stands above it (a handle read 8 mm tall within an 8 mm bound).
+    if (!(MedianDrop(top, apex, across, highest, (at_top + run * band_m) / 2.0) >
+          2.0 * noise_sigma)) {
         return std::nullopt;
     }
     return 1.0 / run;
@@ -230,8 +217,8 @@ PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
     const bool ridge = eig.eigenvalues()(1) > kRidgeElongation * eig.eigenvalues()(0);
     const Eigen::Vector2d across = eig.eigenvectors().col(0);
-    const auto slope =
-        FlankSlope(top, apex, ridge ? &across : nullptr, out.highest, band_m, narrow_m);
+    const auto slope = FlankSlope(top, apex, ridge ? &across : nullptr, out.highest, band_m,
+                                  narrow_m, noise_sigma);
     if (!slope) return out;
     // The apex may stand above the readings by its steepest flank's rise over the farthest it
     // may lie from the nearest: across a ridge, half the readings' spacing; a point among
