@@ -1,8 +1,8 @@
 // Known-answer tests of a sharp top (pipeline/envelope/peak_reach.h): a pyramid whose last
 // millimetres no view read, a prism's ridge, and tops that are not sharp — a flat top, a bag's
 // gentle crown, an upright panel's edge, a strap's flat bar — each read by 18 views on their own
-// jittered 2 mm grids with 1 mm of noise in height; and a pyramid read by 24 views from round
-// it, their noise along slanted rays.
+// jittered 2 mm grids with 1 mm of noise in height; and a pyramid read by the 18 views from
+// round it, their noise along slanted rays.
 #include "pipeline/envelope/peak_reach.h"
 
 #include <gtest/gtest.h>
