@@ -42,9 +42,9 @@ struct PeakReach {
 // view, or empty; `noise_sigma`: a reading's noise in its height), if any: the readings within
 // `band_m` below the highest make the top; it is sharp where it widens going down from the
 // highest readings' point (or, where the top runs along a line, from that ridge line) as
-// flanks do, in proportion, from less than `narrow_m` at the top, rising more than half a
-// metre per metre (FlankSlope), and the readings nearest it lie below the highest beyond the
-// noise (a flat strap over a carton, widened below by its edges' mixed pixels, is not sharp).
+// flanks do, in proportion, from less than `narrow_m` at the top, however gently they rise
+// (FlankSlope), and the readings nearest it lie below the highest beyond the noise (a flat
+// strap over a carton, widened below by its edges' mixed pixels, is not sharp).
 // `narrowest_m`: the narrowest part the readings keep (EnvelopeConfig::narrowest_kept_m).
 PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
                           const std::vector<std::uint16_t>& view, double noise_sigma, double band_m,

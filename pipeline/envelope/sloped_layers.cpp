@@ -1,5 +1,6 @@
 #include "pipeline/envelope/sloped_layers.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -36,6 +37,23 @@ int OffPlaneAllowed(int n) {
     const double beyond = std::erfc(kOffPlaneSigmas / std::sqrt(2.0));
     const double mean = n * beyond;
     return static_cast<int>(mean + 3.0 * std::sqrt(mean * (1.0 - beyond)));
+}
+
+// Whether a layer `c` on one plane turned more than 60 degrees from the direction is a slope
+// going down outward (a low pyramid's face): its normal, turned to face up, is measurably off
+// upright and leans measurably outward (each by more than three of its standard errors: the
+// noise off the plane, `sigma` at least, over the readings' least spread along it, of n
+// readings), and the way it goes down lies within 60 degrees of the direction. A surface running
+// along the direction (the top, or a wall seen along it) leans neither way, and a wall turned
+// sideways goes down no way at all: such a cell holds the surface's end, which bounds nothing.
+bool DescendsOutward(const LayerCell& c, double sigma) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(c.Scatter());
+    Eigen::Vector3d normal = eig.eigenvectors().col(0);  // (across, up, along)
+    if (normal.y() < 0.0) normal = -normal;
+    const double off = std::max(eig.eigenvalues()(0), sigma * sigma);
+    const double se = std::sqrt(off / (std::max(eig.eigenvalues()(1), 1e-12) * c.n));
+    return normal.y() > 3.0 * se && normal.z() > 3.0 * se &&
+           normal.z() >= 0.5 * std::hypot(normal.x(), normal.z());
 }
 
 // The cells of `grid` a sloped layer may fill: fewer than config.min_cell_points readings in
@@ -98,8 +116,8 @@ std::array<std::vector<Entry>, 2> StarvedEntries(const LayerReadings& r, const L
 
 // One side of the layers: each starved cell's readings (`entries`, as the side reads them, in
 // the cells' `slot`s) within the layer's depth of their sub-cell's outermost; a cell is taken
-// where they lie on one plane facing the direction (within 60 degrees), with no more of them
-// off it than the noise leaves.
+// where they lie on one plane facing the direction (within 60 degrees) or going down outward
+// (turned farther, DescendsOutward), with no more of them off it than the noise leaves.
 void FillSide(const std::vector<Entry>& entries, const std::vector<int>& slot, int slots,
               double sigma, const EnvelopeConfig& config, CellGrid<LayerCell>& grid) {
     if (entries.empty()) return;
@@ -130,8 +148,11 @@ void FillSide(const std::vector<Entry>& entries, const std::vector<int>& slot, i
         if (kept[k].n < config.min_cell_points || off > OffPlaneAllowed(first[k].n)) continue;
         double off_plane = 0.0;
         const double facing = kept[k].Facing(&off_plane);
-        if (facing < 0.5 || !OnOnePlane(off_plane, sigma * sigma, kept[k].n)) continue;
+        if (!OnOnePlane(off_plane, sigma * sigma, kept[k].n)) continue;
+        const bool turned = facing < 0.5;
+        if (turned && !DescendsOutward(kept[k], sigma)) continue;
         grid.cells[c] = kept[k];
+        grid.cells[c].turned_away = turned;
     }
 }
 

@@ -13,15 +13,28 @@
 // sub-cell by sub-cell (a quarter of the cell each way), each reading against the outermost of
 // its own sub-cell, among the readings a surface facing the direction within 60 degrees could
 // spread over across the cell (√3 times its diagonal). The cell is taken only where that layer
-// is one plane facing the direction within 60 degrees: its readings lie on it within the noise
-// (the test the cell's reach reads, surface_cells.cpp), and no more of them lie off it than the
-// noise's tail leaves (mixed pixels at a foot, a stray). Two surfaces sharing the cell (a ridge's
-// two faces, a wall's end, a thin panel's two sides) leave it unjudged, as before. A cell taken
-// counts as any other: read at its readings' mean, and at its high end where its slope goes on
-// downhill (layer_marks.h); a plane's outermost point read off so few readings overshot where a
-// sliver of a second surface passed for part of it (a wedge's end, 5-8 mm). Only cells whose
-// outermost reading stands beyond their row's judged cells are read again: a cell read at its
-// mean cannot pass them otherwise, and the rest cost a third of an irregular object's fit.
+// is one plane: its readings lie on it within the noise (the test the cell's reach reads,
+// surface_cells.cpp), and no more of them lie off it than the noise's tail leaves (mixed pixels
+// at a foot, a stray). Two surfaces sharing the cell (a ridge's two faces, a wall's end, a thin
+// panel's two sides) leave it unjudged, as before. A plane facing the direction within 60
+// degrees counts as any other cell: read at its readings' mean, and at its high end where its
+// slope goes on downhill (layer_marks.h); a plane's outermost point read off so few readings
+// overshot where a sliver of a second surface passed for part of it (a wedge's end, 5-8 mm).
+// A plane turned farther away is taken only where it goes down outward, the way the direction
+// looks (DescendsOutward: a low pyramid's faces, rising half a metre per metre or less, face a
+// level direction at 63 degrees or more), and it is read as a facing one is, at its mean or its
+// outer end where it goes on down (LayerCell::turned_away), not as a wall's end; the wall's
+// profile carries it on down to the table (foot_band.h). Read at their means alone, the
+// diagonal directions of a 60 mm pyramid (whose feet the profile did not reach) read narrower
+// than the true rectangle, 274 x 256 mm for 300 x 240. Left unjudged, every cell of such a face
+// was, and pyramids 65-83 mm tall
+// were refused as outlines that "cannot be bounded" (in up to 64 of 180 directions). A surface
+// running along the direction (the top, a wall seen along it) or a wall turned sideways goes
+// down no way outward: its cell holds the surface's end, which bounds nothing, and a side no
+// view faced stays unbounded (taken, a box seen through 140 degrees read 11 mm short within a
+// 3 mm bound). Only cells whose outermost reading stands beyond their row's judged cells are
+// read again: a cell read at its mean cannot pass them otherwise, and the rest cost a third of
+// an irregular object's fit.
 
 #include <Eigen/Core>
 #include <vector>
@@ -58,7 +71,7 @@ LayerReadings CutLevelLayers(const std::vector<Eigen::Vector3d>& across_up_along
 // readings in its layer, at least that many in all, and whose outermost reading stands beyond its
 // row's judged cells, with its sloped surface's layer, where that layer holds enough readings,
 // no more of them off its plane than the noise `sigma` leaves, and is one plane facing the
-// direction.
+// direction within 60 degrees or going down outward (then marked LayerCell::turned_away).
 void FillSlopedCells(const LayerReadings& readings, double sigma, const EnvelopeConfig& config,
                      Layers& layers);
 

@@ -130,6 +130,9 @@ struct ReachModel {
 //    their own along the direction judged (`wall_noise_sigma`), not the facing surface's.
 //  - Two surfaces sharing the cell (a corner: a face and the end of the next one): neither
 //    model holds. The mean is the safe reach, and the uncertainty carries the layer.
+// A face going down outward but turned farther (LayerCell::turned_away) is read as a facing one
+// is, at its mean, or at its outer end where its slope goes on into the next cell
+// (MarkSlopesToReadHigh), uncertain by as much as that end is (HighEndSe).
 // A variance must exceed the noise's by three of its standard errors to count
 // (SampleVarianceSe).
 Reach CellReach(const LayerCell& c, const ReachModel& model) {
@@ -143,6 +146,10 @@ Reach CellReach(const LayerCell& c, const ReachModel& model) {
         const double se_spread = spread > model.noise_sigma ? spread / std::sqrt(12.0) : 0.0;
         return {c.Mean() + c.high_end_above_mean_m + c.cap_above_mean_m,
                 std::hypot(se_spread, c.cap_above_mean_m), c.StdError(), true};
+    }
+    if (c.turned_away) {
+        const double high = c.high_end_above_mean_m;
+        return {c.Mean() + high, HighEndSe(c.Variance(), high * high / 3.0, c.n), c.StdError()};
     }
     const double wall_var = model.wall_var;
     if (!model.walls || var - wall_var <= 3.0 * SampleVarianceSe(wall_var, c.n)) {

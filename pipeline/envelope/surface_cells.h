@@ -76,6 +76,10 @@ struct LayerCell : CellStats {
     // Set by the caller where the cell is the top of a smooth cap (a bag's crown, a lying tube's
     // crest, TopBound): how far the cap's top lies above the readings' mean.
     double cap_above_mean_m = 0.0;
+    // Set where the cell is the layer of a face going down outward, turned more than 60
+    // degrees from the direction (a low pyramid's, sloped_layers.h): read as a facing surface's
+    // mean or high end, not as a wall's end.
+    bool turned_away = false;
 };
 
 // How far a sample variance of `n` readings wanders from the true `variance` (its standard

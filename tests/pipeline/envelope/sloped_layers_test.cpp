@@ -1,9 +1,10 @@
 // Known-answer tests of a sloped surface's outer layer (pipeline/envelope/sloped_layers.h): a
 // face sloping across its cells is judged however little noise it carries, front and back, where
-// it could pass its row's judged cells; a ridge's two faces,
-// a face steeper than 60 degrees and a face with mixed pixels standing off it are not; a pyramid
-// read with little noise is bounded by its faces instead of refused, and a thin fin standing out
-// of a box is still refused as an outline that cannot be bounded.
+// it could pass its row's judged cells, and so is a face turned farther that goes down
+// outward; a ridge's two faces, a wall turned sideways and a face with mixed pixels standing off
+// it are not; pyramids read with little noise, a low one too, are bounded by their faces
+// instead of refused, and a thin fin standing out of a box is still refused as an outline that
+// cannot be bounded.
 #include "pipeline/envelope/sloped_layers.h"
 
 #include <gtest/gtest.h>
@@ -89,10 +90,28 @@ TEST(SlopedLayers, ACellThatCannotPassItsRowsJudgedCellsIsLeftAsItWas) {
     }
 }
 
-TEST(SlopedLayers, ASurfaceSteeperThanSixtyDegreesOrTwoSharingACellStayUnjudged) {
-    // Rising 2 m per metre: its normal 63 degrees from the direction (a wall crossing it); at
-    // 1.3 m per metre the same cells are judged (above).
-    EXPECT_EQ(Judged(Fill([](double, double z) { return 0.1 - 2.0 * z; }, {}, 0.002).front), 0);
+TEST(SlopedLayers, AFaceGoingDownOutwardTurnedFartherIsJudgedOnTheFace) {
+    // Rising half a metre per metre outward (2 m in per metre up): its normal 63 degrees from
+    // the direction, a low pyramid's face. Each cell is judged, marked as turned away, its mean
+    // on the face. Seen from behind it rises outward: its cells there hold the face's upper
+    // end, which bounds nothing, and stay unjudged.
+    auto face = [](double, double z) { return 0.1 - 2.0 * z; };
+    EXPECT_EQ(Judged(Fill(face, {}, 0.002, false).front), 0);
+    const Layers f = Fill(face, {}, 0.002);
+    EXPECT_EQ(Judged(f.front), 16);
+    EXPECT_EQ(Judged(f.back), 0);
+    for (const LayerCell& c : f.front.cells) {
+        EXPECT_TRUE(c.turned_away);
+        EXPECT_NEAR(c.Mean(), face(0.0, c.Centroid().y()), 3.0 * kSigma);
+    }
+}
+
+TEST(SlopedLayers, AWallTurnedSidewaysOrTwoSurfacesSharingACellStayUnjudged) {
+    // An upright wall turned 63 degrees from the direction (2 m in per metre across): its cells
+    // hold its end, which goes down no way outward.
+    const Layers wall = Fill([](double t, double) { return 0.1 - 2.0 * t; }, {}, 0.002);
+    EXPECT_EQ(Judged(wall.front), 0);
+    EXPECT_EQ(Judged(wall.back), 0);
     // A ridge running across the cells 18 mm up, read every 2 mm: its two faces meet in the
     // second row of cells, which keeps its level layer (its crest); the rows clear of it, a
     // face each, are judged.
@@ -130,13 +149,13 @@ void AddCameras(Surface& s) {
     }
 }
 
-// A pyramid on a 0.3 x 0.2 m base, 0.15 m tall, read every 1.5 mm over its faces above the
+// A pyramid on a 0.3 x `w` m base, `h` tall, read every 1.5 mm over its faces above the
 // table's band with 0.3 mm of noise, seen from twelve cameras round it.
-Surface Pyramid() {
+Surface Pyramid(double w, double h) {
     Surface s;
     std::mt19937 rng(7);
     std::normal_distribution<double> noise(0.0, kSigma);
-    const double a = 0.15, b = 0.10, h = 0.15;
+    const double a = 0.15, b = w / 2.0;
     for (double x = -a; x <= a; x += 0.0015) {
         for (double y = -b; y <= b; y += 0.0015) {
             const double z = h * (1.0 - std::max(std::abs(x) / a, std::abs(y) / b));
@@ -154,11 +173,23 @@ TEST(SlopedLayers, APyramidReadWithLittleNoiseIsBoundedByItsFaces) {
     // Its corner ridges run down to the base's corners, and its faces slope across every cell
     // of the diagonal directions: a layer of 1.5 mm held too few of their readings to judge, and
     // the outline was refused as stopping well short of its readings.
-    const auto cuboid = EnvelopeCuboid(Pyramid(), kSigma, kSigma, EnvelopeConfig{});
+    const auto cuboid = EnvelopeCuboid(Pyramid(0.20, 0.15), kSigma, kSigma, EnvelopeConfig{});
     ASSERT_TRUE(cuboid.ok()) << cuboid.error().message;
     EXPECT_NEAR(cuboid->length_m, 0.30, 0.003);
     EXPECT_NEAR(cuboid->width_m, 0.20, 0.003);
     EXPECT_NEAR(cuboid->height_m, 0.15, 0.003);
+}
+
+TEST(SlopedLayers, ALowPyramidIsBoundedByItsFacesGoingDownOutward) {
+    // 60 mm tall on a 0.3 x 0.24 m base: its faces rise 0.4 and 0.5 metres per metre, their
+    // normals 63 and 68 degrees or more from every level direction. No cell of them faces a
+    // direction within 60 degrees, and the outline was refused as stopping well short of its
+    // readings; read at their means, they carry the faces down to the table.
+    const auto cuboid = EnvelopeCuboid(Pyramid(0.24, 0.06), kSigma, kSigma, EnvelopeConfig{});
+    ASSERT_TRUE(cuboid.ok()) << cuboid.error().message;
+    EXPECT_NEAR(cuboid->length_m, 0.30, 0.003);
+    EXPECT_NEAR(cuboid->width_m, 0.24, 0.003);
+    EXPECT_NEAR(cuboid->height_m, 0.06, 0.003);
 }
 
 TEST(SlopedLayers, AThinFinStandingOutOfABoxIsStillRefusedAsUnbounded) {
