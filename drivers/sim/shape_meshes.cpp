@@ -11,13 +11,36 @@ namespace boxd {
 namespace {
 
 // Returns the rings of a loft from t = 0 to 1 (`count` + 1 of them, at heights `length` t), each
-// of half extents `a`, `b` times profile(t).
+// of half extents `a`, `b` times profile(t); with `tolerance_m`, each step is halved until the
+// profile's midpoint lies within it of the step's chord (the larger half extent's outline). Even
+// steps leave a dome's crown, where the profile turns level, a cone: a sack 150 mm tall, 120
+// rings, rose to its apex 1.3 mm over its last 27 mm, 0.3 mm under the dome halfway.
 template <typename Profile>
-std::vector<LoftRing> Rings(double length, double a, double b, int count, const Profile& profile) {
+std::vector<LoftRing> Rings(double length, double a, double b, int count, const Profile& profile,
+                            double tolerance_m = 0.0) {
+    constexpr int kMaxHalvings = 16;
+    const double r = std::max(a, b);
     std::vector<LoftRing> rings;
-    for (int i = 0; i <= count; ++i) {
-        const double t = static_cast<double>(i) / count, s = profile(t);
-        rings.push_back({length * t, a * s, b * s});
+    auto ring = [&](double t) { return LoftRing{length * t, a * profile(t), b * profile(t)}; };
+    // Adds the rings after t0 up to t1, halving the step where the chord strays.
+    auto step = [&](auto&& self, double t0, double t1, int depth) -> void {
+        const double tm = 0.5 * (t0 + t1);
+        const Eigen::Vector2d p0(length * t0, r * profile(t0)), p1(length * t1, r * profile(t1));
+        const Eigen::Vector2d pm(length * tm, r * profile(tm)), chord = p1 - p0;
+        const double off =
+            chord.norm() > 0.0
+                ? std::abs(chord.x() * (pm - p0).y() - chord.y() * (pm - p0).x()) / chord.norm()
+                : 0.0;
+        if (tolerance_m > 0.0 && depth < kMaxHalvings && off > tolerance_m) {
+            self(self, t0, tm, depth + 1);
+            self(self, tm, t1, depth + 1);
+            return;
+        }
+        rings.push_back(ring(t1));
+    };
+    rings.push_back(ring(0.0));
+    for (int i = 0; i < count; ++i) {
+        step(step, static_cast<double>(i) / count, static_cast<double>(i + 1) / count, 0);
     }
     return rings;
 }
@@ -35,7 +58,8 @@ TriangleMesh MakeSackMesh(double l, double w, double h) {
         const double u = (t - kShoulder) / (1.0 - kShoulder);
         return kUpper * std::sqrt(std::max(0.0, 1.0 - u * u));
     };
-    return MakeLoftMesh(Rings(h, l / 2.0, w / 2.0, 120, profile), 3.0);
+    // Its rings follow the profile to 50 micrometres, the crown a dome to its apex.
+    return MakeLoftMesh(Rings(h, l / 2.0, w / 2.0, 120, profile, 5e-5), 3.0);
 }
 
 TriangleMesh MakeLyingBottleMesh(double l, double d) {
