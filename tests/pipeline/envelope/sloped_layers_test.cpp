@@ -169,27 +169,28 @@ Surface Pyramid(double w, double h) {
     return s;
 }
 
+// The enclosing cuboid of Pyramid(w, h) is measured, 0.3 x w x h within 3 mm.
+void ExpectBoundedByItsFaces(double w, double h) {
+    const auto cuboid = EnvelopeCuboid(Pyramid(w, h), kSigma, kSigma, EnvelopeConfig{});
+    ASSERT_TRUE(cuboid.ok()) << cuboid.error().message;
+    EXPECT_NEAR(cuboid->length_m, 0.30, 0.003);
+    EXPECT_NEAR(cuboid->width_m, w, 0.003);
+    EXPECT_NEAR(cuboid->height_m, h, 0.003);
+}
+
 TEST(SlopedLayers, APyramidReadWithLittleNoiseIsBoundedByItsFaces) {
     // Its corner ridges run down to the base's corners, and its faces slope across every cell
     // of the diagonal directions: a layer of 1.5 mm held too few of their readings to judge, and
     // the outline was refused as stopping well short of its readings.
-    const auto cuboid = EnvelopeCuboid(Pyramid(0.20, 0.15), kSigma, kSigma, EnvelopeConfig{});
-    ASSERT_TRUE(cuboid.ok()) << cuboid.error().message;
-    EXPECT_NEAR(cuboid->length_m, 0.30, 0.003);
-    EXPECT_NEAR(cuboid->width_m, 0.20, 0.003);
-    EXPECT_NEAR(cuboid->height_m, 0.15, 0.003);
+    ExpectBoundedByItsFaces(0.20, 0.15);
 }
 
 TEST(SlopedLayers, ALowPyramidIsBoundedByItsFacesGoingDownOutward) {
     // 60 mm tall on a 0.3 x 0.24 m base: its faces rise 0.4 and 0.5 metres per metre, their
     // normals 63 and 68 degrees or more from every level direction. No cell of them faces a
     // direction within 60 degrees, and the outline was refused as stopping well short of its
-    // readings; read at their means, they carry the faces down to the table.
-    const auto cuboid = EnvelopeCuboid(Pyramid(0.24, 0.06), kSigma, kSigma, EnvelopeConfig{});
-    ASSERT_TRUE(cuboid.ok()) << cuboid.error().message;
-    EXPECT_NEAR(cuboid->length_m, 0.30, 0.003);
-    EXPECT_NEAR(cuboid->width_m, 0.24, 0.003);
-    EXPECT_NEAR(cuboid->height_m, 0.06, 0.003);
+    // readings; read as facing ones are, they carry the faces down to the table.
+    ExpectBoundedByItsFaces(0.24, 0.06);
 }
 
 TEST(SlopedLayers, AThinFinStandingOutOfABoxIsStillRefusedAsUnbounded) {
