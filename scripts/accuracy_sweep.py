@@ -330,6 +330,12 @@ def main():
                   f"{' '.join(o['args'])}")
         else:
             print(f"{o['name']:10s} {o['status']} {o.get('reason', '')}  {' '.join(o['args'])}")
+    # A drawn object the simulated station cannot hold (its footprint off the disc) is no
+    # measurement: left out of every count, and said so.
+    unrendered = [o for o in outcomes if o["status"] == "synth failed"]
+    if unrendered:
+        print(f"\nleft out, not rendered: {', '.join(o['name'] for o in unrendered)}")
+        outcomes = [o for o in outcomes if o not in unrendered]
     if args.objects == "pairs":
         answered = [o for o in outcomes if "dimensions_mm" in o]
         refused = sorted(o.get("reason", o["status"]) for o in outcomes if o not in answered)
