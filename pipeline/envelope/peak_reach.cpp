@@ -241,7 +241,16 @@ void ReadSharpTop(const Surface& surface, double height_sigma, const EnvelopeCon
     const PeakReach peak =
         ExtrapolatePeak(surface.points, surface.view, height_sigma, 2.0 * config.cell_height_m,
                         config.cell_along_m, config.narrowest_kept_m);
-    if (!peak.sharp) return;
+    if (!peak.sharp) {
+        // Its highest readings still hold the height from below where they stand above the
+        // cells beyond their noise: a top too thin for any cell, its flanks steeper than any
+        // (a narrow pyramid's last centimetres read as a fin's edge, 28 mm above its cells).
+        if (peak.highest > *height + 2.0 * height_sigma) {
+            *height = peak.highest;
+            *se = std::max(*se, height_sigma);
+        }
+        return;
+    }
     spdlog::debug(
         "envelope: a sharp top, its highest readings {:.2f} mm above the cells', slope "
         "{:.2f}, spacing {:.2f} mm",

@@ -53,7 +53,9 @@ PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
 // A sharp peak or ridge thins the top's cells out below it (peak_reach.h): its highest
 // readings hold the height where they stand above the cells' `height`, and the apex may stand
 // above them by the flanks' slope times the readings' spacing; read halfway, the bound `se`
-// reaching both ends. `height_sigma`: a reading's noise in its height.
+// reaching both ends. A top that is no sharp peak (too steep for flanks, a fin's edge) is held
+// by its highest readings where they stand above the cells by more than twice a reading's
+// noise in its height, `height_sigma`.
 void ReadSharpTop(const Surface& surface, double height_sigma, const EnvelopeConfig& config,
                   double* height, double* se);
 

@@ -2,7 +2,8 @@
 // millimetres no view read, a prism's ridge, and tops that are not sharp — a flat top, a bag's
 // gentle crown, an upright panel's edge, a strap's flat bar — each read by 18 views on their own
 // jittered 2 mm grids with 1 mm of noise in height; and a pyramid read by the 18 views from
-// round it, their noise along slanted rays.
+// round it, their noise along slanted rays. A top too thin for any cell is held by its highest
+// readings.
 #include "pipeline/envelope/peak_reach.h"
 
 #include <gtest/gtest.h>
@@ -161,6 +162,29 @@ TEST(PeakReach, AStrapsFlatBarWidenedBelowByMixedPixelsIsNotSharp) {
     };
     for (unsigned seed = 1; seed <= 3; ++seed) {
         EXPECT_FALSE(Peak(Sample(bar, 0.05, 1.0, seed)).sharp) << "seed " << seed;
+    }
+}
+
+// An upright panel 4 mm thick, 200 mm tall, whose top's cells read 50 mm below its edge (a top
+// too thin for any cell, a narrow pyramid's last centimetres): its highest readings hold the
+// height from below. A flat top's cells, read at its height, stay as they are.
+TEST(PeakReach, AThinTopsHighestReadingsHoldTheHeightAboveItsCells) {
+    auto panel = [](double, double y) { return std::abs(y) <= 0.002 ? 0.2 : NAN; };
+    auto flat = [](double, double) { return 0.2; };
+    for (unsigned seed = 1; seed <= 3; ++seed) {
+        const Cloud fin = Sample(panel, 0.1, 1.0, seed), top = Sample(flat, 0.1, 1.0, seed);
+        Surface s;
+        s.points = fin.points;
+        s.view = fin.view;
+        double height = 0.15, se = 1e-4;
+        ReadSharpTop(s, kNoise, EnvelopeConfig{}, &height, &se);
+        EXPECT_NEAR(height, 0.2, 3.0 * kNoise) << "seed " << seed;
+        EXPECT_GE(se, kNoise) << "seed " << seed;
+        s.points = top.points;
+        s.view = top.view;
+        height = 0.2;
+        ReadSharpTop(s, kNoise, EnvelopeConfig{}, &height, &se);
+        EXPECT_EQ(height, 0.2) << "seed " << seed;
     }
 }
 
