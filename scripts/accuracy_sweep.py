@@ -318,7 +318,6 @@ def main():
         cases = [draw_effect(rng, case) for case in cases]
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         outcomes = list(pool.map(lambda c: run_case(args.boxd, c), cases))
-
     measured = [o for o in outcomes if "error_mm" in o]
     for o in outcomes:
         if "dimensions_mm" in o:
@@ -330,12 +329,10 @@ def main():
                   f"{' '.join(o['args'])}")
         else:
             print(f"{o['name']:10s} {o['status']} {o.get('reason', '')}  {' '.join(o['args'])}")
-    # A drawn object the simulated station cannot hold (its footprint off the disc) is no
-    # measurement: left out of every count, and said so.
-    unrendered = [o for o in outcomes if o["status"] == "synth failed"]
-    if unrendered:
-        print(f"\nleft out, not rendered: {', '.join(o['name'] for o in unrendered)}")
-        outcomes = [o for o in outcomes if o not in unrendered]
+    # A drawn object the station cannot hold (off the disc) is no measurement: left out, named.
+    unrendered = [o["name"] for o in outcomes if o["status"] == "synth failed"]
+    print(f"\nleft out, not rendered: {', '.join(unrendered)}" if unrendered else "", end="")
+    outcomes = [o for o in outcomes if o["name"] not in unrendered]
     if args.objects == "pairs":
         answered = [o for o in outcomes if "dimensions_mm" in o]
         refused = sorted(o.get("reason", o["status"]) for o in outcomes if o not in answered)
