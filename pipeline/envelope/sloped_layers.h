@@ -27,14 +27,13 @@
 // profile carries it on down to the table (foot_band.h). Read at their means alone, the
 // diagonal directions of a 60 mm pyramid (whose feet the profile did not reach) read narrower
 // than the true rectangle, 274 x 256 mm for 300 x 240. Left unjudged, every cell of such a face
-// was, and pyramids 65-83 mm tall
-// were refused as outlines that "cannot be bounded" (in up to 64 of 180 directions). A surface
-// running along the direction (the top, a wall seen along it) or a wall turned sideways goes
-// down no way outward: its cell holds the surface's end, which bounds nothing, and a side no
-// view faced stays unbounded (taken, a box seen through 140 degrees read 11 mm short within a
-// 3 mm bound). Only cells whose outermost reading stands beyond their row's judged cells are
-// read again: a cell read at its mean cannot pass them otherwise, and the rest cost a third of
-// an irregular object's fit.
+// was, and pyramids 65-83 mm tall were refused as outlines that "cannot be bounded" (in up to
+// 64 of 180 directions). A surface running along the direction (the top, a wall seen along it)
+// or a wall turned sideways goes down no way outward: its cell holds the surface's end, which
+// bounds nothing, and a side no view faced stays unbounded (taken, a box seen through 140
+// degrees read 11 mm short within a 3 mm bound). Only cells whose outermost reading stands
+// beyond their row's judged cells are read again: a cell read at its mean cannot pass them
+// otherwise, and the rest cost a third of an irregular object's fit.
 
 #include <Eigen/Core>
 #include <vector>
