@@ -31,6 +31,8 @@
 //   - the foot band (the readings within min_z_m of the table are the table's): a wall sloping
 //     outward is extended down to the table at its slope, the extension's own uncertainty and
 //     the bend of its profile in the bound; an upright wall stays where it is (foot_band.h);
+//   - a cuboid's side face between its edge margins, which no face cell judges: a face leaning
+//     out towards the table or the top is carried there along its rows' line (leaning_face.h);
 //   - a wall's foot that nothing read (a dark or glossy base, a shadow): the table's readings
 //     beside the object bound how far it may go, the wall's extrapolation is held within that
 //     and the bound reaches it, and back to the readings where the table was read where the

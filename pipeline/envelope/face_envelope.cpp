@@ -11,6 +11,7 @@
 #include "pipeline/core/student_t.h"
 #include "pipeline/envelope/bowed_face.h"
 #include "pipeline/envelope/face_windows.h"
+#include "pipeline/envelope/leaning_face.h"
 #include "pipeline/envelope/surface_cells.h"
 #include "pipeline/fit/face_choice.h"
 
@@ -40,6 +41,8 @@ struct FaceCells {
     int na = 1;                 // cells across the face's grid: a cell's key is row * na + column
     int nb = 1;                 // cells up the face's grid
     double da = 1.0, db = 1.0;  // the cells' size across and up the face
+    double b0 = 0.0;            // where the grid's rows start up the face
+    double height = 0.0;        // a side face's height (the top: 0, no lean is read)
     std::unordered_map<std::size_t, CellStats> cell_view;  // key cell * views + view
     std::vector<CellStats> view_plane;                     // per view: offsets near the plane
 
@@ -168,7 +171,23 @@ struct FaceCells {
         ReadExcess(many, config, out.view_spread_m, &out);
         ReadBow(judged, config, &out);
         if (pool.Pooled()) ReadPatches(many, pool.shared, config, &out);
+        ReadLean(judged, &out);
         return out;
+    }
+    // A side face leaning out towards the table or the top (leaning_face.h).
+    void ReadLean(const std::vector<Judged>& judged, FaceResult* out) const {
+        if (!(height > 0.0)) return;
+        std::vector<FaceProfileCell> cells;
+        cells.reserve(judged.size());
+        for (const Judged& c : judged) {
+            const auto row = static_cast<double>(c.key / static_cast<std::size_t>(na));
+            cells.push_back({b0 + (row + 0.5) * db, c.st.Mean(), c.se});
+        }
+        const auto lean = LeaningFaceReach(cells, db, height);
+        if (lean && lean->reach > out->excess_m) {
+            out->excess_m = lean->reach;
+            out->excess_se_m = lean->se;
+        }
     }
 
     // A panel bowing out smoothly shows as a whole face (bowed_face.h).
@@ -297,6 +316,8 @@ std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& b
         faces[f].nb = grids[f].nb;
         faces[f].da = grids[f].da;
         faces[f].db = grids[f].db;
+        faces[f].b0 = grids[f].b0;
+        faces[f].height = f < 4 ? h : 0.0;
     }
     // Every reading, as the face fits read them (fusion.h): the support test's voxels keep the
     // readings on one side of a voxel wall and drop the thinner layer on the other, and a face

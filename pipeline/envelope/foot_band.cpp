@@ -1,18 +1,15 @@
 #include "pipeline/envelope/foot_band.h"
 
-#include <Eigen/Dense>
 #include <cmath>
 #include <optional>
 #include <utility>
 #include <vector>
 
+#include "pipeline/envelope/wall_profile.h"
+
 namespace boxd::envelope {
 
 namespace {
-
-// How many standard errors an outward slope must stand clear of zero to be extended: a wall
-// that is upright within its noise is not moved by it.
-constexpr double kSlopeSigmas = 3.0;
 
 // The rows of the wall's profile read above the band: five 12 mm rows, 60 mm of the wall.
 constexpr int kProfileRows = 5;
@@ -20,9 +17,7 @@ constexpr int kProfileRows = 5;
 // A row's outermost judged cell: its mean reach, less the median of the largest of as many
 // noise draws as cells compete for it (the largest of many noisy means stands out by that much),
 // its standard error and its readings' mean height.
-struct RowReach {
-    double s = 0.0, se = 0.0, z = 0.0;
-};
+using RowReach = ProfileRow;
 
 // The outermost of a row's `na` cells holding at least `min_points` readings, by `reach`, and how
 // many cells compete for it: those within two standard errors (`se`) of it.
@@ -54,44 +49,6 @@ std::optional<RowReach> OutermostInRow(const CellGrid<LayerCell>& layer, int row
                     best->Centroid().y()};
 }
 
-// A weighted least-squares polynomial through rows (z, s, se): its value and standard error at
-// the table (z = 0), and its slope (ds/dz at the rows' mean height) with its standard error,
-// both widened by the fit's reduced chi-square where the rows stray from it.
-struct PolyFit {
-    double at_table = 0.0, at_table_se = 0.0, slope = 0.0, slope_se = 0.0;
-};
-
-std::optional<PolyFit> FitRows(const std::vector<RowReach>& rows, int degree) {
-    const int n = static_cast<int>(rows.size()), m = degree + 1;
-    if (n <= degree) return std::nullopt;
-    Eigen::MatrixXd a(n, m);
-    Eigen::VectorXd y(n), w(n);
-    double zbar = 0.0;
-    for (const RowReach& r : rows) zbar += r.z / n;
-    for (int i = 0; i < n; ++i) {
-        for (int k = 0; k < m; ++k) a(i, k) = std::pow(rows[i].z, k);
-        y(i) = rows[i].s;
-        w(i) = 1.0 / std::max(rows[i].se * rows[i].se, 1e-12);
-    }
-    const Eigen::MatrixXd normal = a.transpose() * w.asDiagonal() * a;
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(normal);
-    if (ldlt.info() != Eigen::Success) return std::nullopt;
-    const Eigen::VectorXd coef = ldlt.solve(a.transpose() * w.asDiagonal() * y);
-    const Eigen::MatrixXd cov = ldlt.solve(Eigen::MatrixXd::Identity(m, m));
-    const Eigen::VectorXd r = y - a * coef;
-    const double chi2 = r.dot(w.asDiagonal() * r);
-    const double scale = n > m ? std::sqrt(std::max(1.0, chi2 / (n - m))) : 1.0;
-    // d/dz at zbar: the gradient of the polynomial's derivative with respect to its coefficients.
-    Eigen::VectorXd g = Eigen::VectorXd::Zero(m);
-    for (int k = 1; k < m; ++k) g(k) = k * std::pow(zbar, k - 1);
-    PolyFit out;
-    out.at_table = coef(0);
-    out.at_table_se = scale * std::sqrt(cov(0, 0));
-    out.slope = -g.dot(coef);  // outward per metre, going down
-    out.slope_se = scale * std::sqrt(g.dot(cov * g));
-    return out;
-}
-
 // Returns the lowest of `rows` (`row_height` apart) that are one wall: the profile ends below
 // the first row that departs from the line through the rows under it by more than a row's
 // height. Between them the surface runs nearer level than upright against that line: a ledge,
@@ -100,7 +57,7 @@ std::optional<PolyFit> FitRows(const std::vector<RowReach>& rows, int degree) {
 // plane or bending, stay within their noise and curvature of it.
 std::vector<RowReach> OneWall(std::vector<RowReach> rows, double row_height) {
     for (std::size_t k = 2; k < rows.size(); ++k) {
-        const auto below = FitRows(std::vector<RowReach>(rows.begin(), rows.begin() + k), 1);
+        const auto below = FitProfile(std::vector<RowReach>(rows.begin(), rows.begin() + k), 1);
         if (below &&
             std::abs(rows[k].s - (below->at_table - below->slope * rows[k].z)) > row_height) {
             rows.resize(k);
@@ -124,21 +81,6 @@ bool NothingReadBelow(const CellGrid<LayerCell>& layer, int first, const Envelop
     return readings < config.min_cell_points;
 }
 
-// Whether `rows` are a flank sloping outward, going down: their line, and the lines above their
-// lowest row and below their highest, slope outward beyond their noise. One row standing out
-// alone is no flank (a silhouette's few stray readings beside an upright tube at its foot), nor
-// one standing in above an upright foot (a ledge's wall). Returns the rows' line where they are.
-std::optional<PolyFit> OutwardLine(const std::vector<RowReach>& rows) {
-    const auto line = FitRows(rows, 1);
-    const auto upper = FitRows(std::vector<RowReach>(rows.begin() + 1, rows.end()), 1);
-    const auto lower = FitRows(std::vector<RowReach>(rows.begin(), rows.end() - 1), 1);
-    const auto outward = [](const std::optional<PolyFit>& f) {
-        return f && f->slope > kSlopeSigmas * f->slope_se;
-    };
-    if (!outward(line) || !outward(upper) || !outward(lower)) return std::nullopt;
-    return line;
-}
-
 // A column's readings of one row within the window about the wall's line: their count, sums of
 // along and up, and of their offsets from the line and its squares.
 struct WindowCell {
@@ -156,7 +98,7 @@ struct WindowCell {
 // standing farthest out of the line, corrected as OutermostInRow corrects its cell. Stops at the
 // first row no column of which holds enough readings.
 std::vector<RowReach> ReadRowsAgain(const CellGrid<LayerCell>& layer, const WallReadings& readings,
-                                    int first, int count, const PolyFit& line, double window,
+                                    int first, int count, const ProfileFit& line, double window,
                                     const EnvelopeConfig& config) {
     const int na = layer.na;
     std::vector<WindowCell> cells(static_cast<std::size_t>(count) * static_cast<std::size_t>(na));
@@ -217,7 +159,7 @@ FootReach ExtrapolateFoot(const CellGrid<LayerCell>& layer, const WallReadings& 
     if (rows.size() < 3 || !OutwardLine(rows)) return out;
     // Read again about the line, twice: the first line stands out by the slivers' lean.
     for (int pass = 0; pass < 2; ++pass) {
-        const PolyFit line = *FitRows(rows, 1);
+        const ProfileFit line = *FitProfile(rows, 1);
         const double window = config.layer_sigmas * sigma * std::hypot(1.0, line.slope);
         auto again = ReadRowsAgain(layer, readings, first, static_cast<int>(rows.size()), line,
                                    window, config);
@@ -227,14 +169,9 @@ FootReach ExtrapolateFoot(const CellGrid<LayerCell>& layer, const WallReadings& 
     const auto line = OutwardLine(rows);
     if (!line) return out;
     out.slope = line->slope;
-    out.reach = line->at_table;
-    double variance = line->at_table_se * line->at_table_se;
-    // A profile that bends may go on bending through the band: where a parabola fits the rows,
-    // how far its foot lies from the line's counts as one standard error.
-    if (const auto curve = FitRows(rows, 2)) {
-        variance += std::pow(curve->at_table - line->at_table, 2);
-    }
-    out.se = std::sqrt(variance);
+    const ProfileFoot foot = FootOfLine(rows, *line);
+    out.reach = foot.reach;
+    out.se = foot.se;
     return out;
 }
 
