@@ -229,6 +229,8 @@ Result<EnclosingCuboid> FitEnclosingCuboid(const FusedCloud& cloud, const Result
     const double height_sigma = box && !box->top_observed
                                     ? envelope::HeightNoiseSigma(sigma, camera_m, surface.top)
                                     : sigma;
+    spdlog::debug("envelope: the readings' noise {:.3f} mm, in the top's height {:.3f} mm",
+                  sigma * 1e3, height_sigma * 1e3);
     double face_excess = 0.0;  // the face fit's, when it was tried: a deciding figure either way
     if (box) {
         double lu = 0.0, lv = 0.0;

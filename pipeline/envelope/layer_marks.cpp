@@ -10,7 +10,13 @@ namespace boxd::envelope {
 void MarkSlopesToReadHigh(CellGrid<LayerCell>* grid, double sigma, const EnvelopeConfig& config) {
     std::vector<LayerCell::Slope> slopes(grid->cells.size());
     for (std::size_t k = 0; k < grid->cells.size(); ++k) {
-        if (grid->cells[k].n >= config.min_cell_points) slopes[k] = grid->cells[k].BestSlope(sigma);
+        const LayerCell& c = grid->cells[k];
+        if (c.n < config.min_cell_points) continue;
+        // Two surfaces sharing the cell (a ledge's edge: a wall and the ledge behind it) are no
+        // slope, however a plane through both of them rises.
+        double off_plane = 0.0;
+        c.Facing(&off_plane);
+        if (OnOnePlane(off_plane, sigma * sigma, c.n)) slopes[k] = c.BestSlope(sigma);
     }
     auto slope_at = [&](int i, int j) -> const LayerCell::Slope& {
         return slopes[static_cast<std::size_t>(grid->CellAt(i, j) - grid->cells.data())];
@@ -33,6 +39,9 @@ void MarkSlopesToReadHigh(CellGrid<LayerCell>* grid, double sigma, const Envelop
     }
 }
 
+// How many standard errors a cell's means must curve down by to mark a cap's top.
+constexpr double kCurvedSigmas = 3.0;
+
 void MarkCapTops(CellGrid<LayerCell>* grid, double sigma, const EnvelopeConfig& config) {
     const double layer = config.layer_sigmas * sigma;
     std::vector<double> cap(grid->cells.size(), 0.0);
@@ -41,15 +50,23 @@ void MarkCapTops(CellGrid<LayerCell>* grid, double sigma, const EnvelopeConfig& 
         if (c.n < config.min_cell_points || c.high_end_above_mean_m > 0.0) continue;
         const int i = static_cast<int>(k % static_cast<std::size_t>(grid->na));
         const int j = static_cast<int>(k / static_cast<std::size_t>(grid->na));
-        double laplacian = 0.0;
+        // A cell's mean is known no better than the noise over its readings' count.
+        auto mean_var = [sigma](const LayerCell& cell) {
+            return std::max(cell.StdError() * cell.StdError(), sigma * sigma / cell.n);
+        };
+        double laplacian = 0.0, variance = 16.0 * mean_var(c);
         bool smooth = true;
         for (const auto& [di, dj] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
             const LayerCell* nb = grid->CellAt(i + di, j + dj);
             smooth = smooth && nb != nullptr && nb->n >= config.min_cell_points &&
                      std::abs(nb->Mean() - c.Mean()) <= layer;
-            if (smooth) laplacian += nb->Mean() - c.Mean();
+            if (!smooth) break;
+            laplacian += nb->Mean() - c.Mean();
+            variance += mean_var(*nb);
         }
-        if (smooth) cap[k] = std::max(0.0, -laplacian / 24.0);
+        // Curved down beyond the noise: a flat top's noisy means would otherwise crest at
+        // every cell that came out high, and the highest of them is the one read.
+        if (smooth && -laplacian > kCurvedSigmas * std::sqrt(variance)) cap[k] = -laplacian / 24.0;
     }
     for (std::size_t k = 0; k < cap.size(); ++k) grid->cells[k].cap_above_mean_m = cap[k];
 }

@@ -11,7 +11,8 @@ namespace boxd::envelope {
 // A sloped patch of an outer layer (the top's: an opened panel, a tube's shoulder; a side's: the
 // panel's outer face leaning in from its hinge) reaches its high end at its uphill side, above
 // its readings' mean: such a cell is read there (LargestBound). A patch is
-// sloped when its readings lie on a plane that rises by more than the noise and the surface
+// sloped when its readings lie on one plane (OnOnePlane: not a ledge's edge, where a wall and
+// the ledge behind it share the cell) that rises by more than the noise, and the surface
 // continues downhill: the neighbouring cell that way slopes the same way. A slope that ends at
 // its cell is a rim instead (a level top's edge with the wall below it sharing the cell), and
 // its high end is the level top's, which the mean already reads.
@@ -21,9 +22,12 @@ void MarkSlopesToReadHigh(CellGrid<LayerCell>* grid, double sigma, const Envelop
 // it crests in: on a quadratic surface z = z0 - (κx x² + κy y²) / 2 the mean over a square cell
 // of side c lies (κx + κy) c² / 24 below the top, and the cell means' discrete Laplacian (the
 // four neighbours' means less four times the cell's) is -(κx + κy) c². So a cell whose four
-// neighbours are judged is marked that far, a 24th of its negative Laplacian. A neighbour more
-// than the layer's depth away is another surface (an opened panel's tip over the box's top), not
-// the cap curving on, and the cell is left as it is.
+// neighbours are judged is marked that far, a 24th of its negative Laplacian, where that
+// Laplacian is below zero by three of its standard errors (each mean known no better than the
+// noise `sigma` over its count): noise is no curvature, and on a flat top the cell read is the
+// one whose noise came out highest, which its own Laplacian would crest. A neighbour more than
+// the layer's depth away is another surface (an opened panel's tip over the box's top), not the
+// cap curving on, and the cell is left as it is.
 void MarkCapTops(CellGrid<LayerCell>* grid, double sigma, const EnvelopeConfig& config);
 
 // A ridge of the top (an opened panel's tip: its outer face falling away steeply on one side,

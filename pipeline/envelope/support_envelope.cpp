@@ -1,6 +1,7 @@
 #include "pipeline/envelope/support_envelope.h"
 
 #include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cmath>
@@ -196,6 +197,11 @@ Result<EnclosingCuboid> CuboidOf(const Surface& surface, const LeastRectangle& r
     // The sides' own direction, where the alike rectangles' sides were read turned from the least.
     const double phi = r.phi + (averaged ? alike.turn : 0.0);
     const Eigen::Vector2d axis(std::cos(phi), std::sin(phi));
+    spdlog::debug(
+        "envelope: least rectangle at {:.2f} deg, {:.2f} x {:.2f} mm (se {:.2f} {:.2f}); {} alike, "
+        "read {:.2f} deg from it: {:.2f} x {:.2f} mm",
+        r.phi * 180.0 / M_PI, su.Width() * 1e3, sv.Width() * 1e3, su.WidthSe() * 1e3,
+        sv.WidthSe() * 1e3, alike.orientations, alike.turn * 180.0 / M_PI, lu * 1e3, lv * 1e3);
     c.length_axis = lu >= lv ? axis : Eigen::Vector2d(-axis.y(), axis.x());
     double se_top = 0.0;
     c.height_m = TopBound(surface.points, sigma, height_sigma, surface.radius, config, &se_top);

@@ -106,7 +106,9 @@ double MedianOfLargest(int m);
 // neither out nor in. A flat face has many such cells (a large correction), a tube's tangent few.
 // A cell's noise is its mean's standard error, and where it reads a wall's end above its mean
 // the error of that reading too (HighEndSe): many small cells of a noisy wall would otherwise
-// offer one whose spread happened to come out wide.
+// offer one whose spread happened to come out wide. A facing cell's is no smaller than the
+// facing cells' scatter off their planes, pooled, over its count: one whose dozen readings
+// happened to cluster would otherwise claim a small noise and win.
 // `cell_extent_m` is the cells' larger side; `se` receives the chosen cell's standard error (with
 // a sloped surface's spread), `judged` the number of cells with enough points. Without `walls`
 // every cell reads as a surface facing the direction (its mean), none as a wall's end. Returns

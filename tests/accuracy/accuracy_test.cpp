@@ -41,7 +41,8 @@ struct Outcome {
     std::string reason;
     std::string message;  // the refusal's message
     double tol = 0.0;
-    double err[3] = {NAN, NAN, NAN};          // length, width, height (measured - true), metres
+    bool bounded = false;             // every dimension's error must lie within its own bound too
+    double err[3] = {NAN, NAN, NAN};  // length, width, height (measured - true), metres
     double uncertainty[3] = {NAN, NAN, NAN};  // the reported 95% bounds, metres
     double processing_ms = 0.0;
 };
@@ -91,6 +92,7 @@ Outcome RunCase(const json& c) {
     Outcome o;
     o.name = c["name"].get<std::string>();
     o.tol = c.value("tol_m", 0.0);
+    o.bounded = c.value("bounded", false);
     o.group = c.value("group", "box");
     o.expect_shape = ExpectedShape(o.group);
     o.expect = c.value("expect", "");
@@ -286,6 +288,10 @@ TEST(Accuracy, SyntheticSuiteWithinTolerance) {
         EXPECT_EQ(o.shape, o.expect_shape) << o.name;
         for (int k = 0; k < 3; ++k) {
             EXPECT_LE(std::abs(o.err[k]), o.tol) << o.name << " dimension " << k;
+            if (o.bounded) {
+                EXPECT_LE(std::abs(o.err[k]), o.uncertainty[k] + kWrittenSlackM)
+                    << o.name << " dimension " << k << " beyond its bound";
+            }
         }
     }
 }

@@ -1,11 +1,12 @@
 // The marks of an outer layer's cells on hand-made surfaces: a smooth cap's top above its cell's
-// mean by a 24th of the cell means' negative Laplacian, nothing on a flat top, and no mark where
-// a neighbour is another surface.
+// mean by a 24th of the cell means' negative Laplacian, nothing on a flat top, noisy or not, and
+// no mark where a neighbour is another surface.
 #include "pipeline/envelope/layer_marks.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 namespace boxd::envelope {
 namespace {
@@ -39,6 +40,31 @@ TEST(MarkCapTops, AFlatTopIsNoCap) {
     auto grid = Read([](double, double) { return 0.3; });
     MarkCapTops(&grid, 0.0005, EnvelopeConfig{});
     for (const LayerCell& c : grid.cells) EXPECT_NEAR(c.cap_above_mean_m, 0.0, 1e-9);
+}
+
+TEST(MarkCapTops, AFlatTopsNoiseIsNoCap) {
+    // A top read with 1.5 mm of noise, a dozen readings a cell: the means scatter by 0.4 mm, and
+    // half the cells have a negative Laplacian; the noise is no curvature.
+    constexpr double kSigma = 0.0015;
+    std::mt19937 rng(5);
+    std::normal_distribution<double> noise(0.0, kSigma);
+    int marked = 0, cells = 0;
+    for (int trial = 0; trial < 20; ++trial) {
+        CellGrid<LayerCell> grid(-3.5 * kCell, 3.5 * kCell, -3.5 * kCell, 3.5 * kCell, kCell,
+                                 kCell);
+        for (double a = -3.5 * kCell + 0.001; a < 3.5 * kCell; a += 0.003) {
+            for (double b = -3.5 * kCell + 0.001; b < 3.5 * kCell; b += 0.004) {
+                grid.At(a, b)->Add3(a, b, 0.3 + noise(rng));
+            }
+        }
+        MarkCapTops(&grid, kSigma, EnvelopeConfig{});
+        for (const LayerCell& c : grid.cells) {
+            ++cells;
+            marked += c.cap_above_mean_m > 0.0;
+        }
+    }
+    // Three standard errors: hardly ever by noise.
+    EXPECT_LE(marked, cells / 100);
 }
 
 TEST(MarkCapTops, ANeighbourBeyondTheLayerIsAnotherSurface) {

@@ -70,5 +70,33 @@ TEST(HighEndSe, ShrinksWithMoreReadingsAndStaysWithinHalfASpread) {
     EXPECT_EQ(HighEndSe(spread, spread, 1), 0.0);
 }
 
+TEST(LargestBound, AFlatFacesCellsAreNotWonByThoseWhoseReadingsHappenedToCluster) {
+    // A face read with 1.5 mm of noise, a dozen readings in each of 300 cells: some cells'
+    // readings cluster by chance, claim a small noise and would be corrected by little. The
+    // reach is read where noise alone moves it neither out nor in: its median over many faces
+    // lies at the face, within a fraction of a cell's standard error.
+    constexpr double kSigma = 0.0015, kCell = 0.012;
+    constexpr int kPerCell = 12;
+    std::mt19937 rng(17);
+    std::normal_distribution<double> noise(0.0, kSigma);
+    std::uniform_real_distribution<double> at(0.0, kCell);
+    std::vector<double> reach;
+    for (int trial = 0; trial < 41; ++trial) {
+        std::vector<LayerCell> cells(300);
+        for (std::size_t k = 0; k < cells.size(); ++k) {
+            const double a0 = static_cast<double>(k % 20) * kCell, b0 = (k / 20) * kCell;
+            for (int r = 0; r < kPerCell; ++r)
+                cells[k].Add3(a0 + at(rng), b0 + at(rng), noise(rng));
+        }
+        double se = 0.0;
+        int judged = 0;
+        reach.push_back(LargestBound(cells, EnvelopeConfig{}, kSigma, kSigma, kCell, &se, &judged));
+    }
+    std::nth_element(reach.begin(), reach.begin() + 20, reach.end());
+    const double cell_se = kSigma / std::sqrt(kPerCell);
+    EXPECT_LT(reach[20], 0.5 * cell_se);
+    EXPECT_GT(reach[20], -1.0 * cell_se);
+}
+
 }  // namespace
 }  // namespace boxd::envelope
