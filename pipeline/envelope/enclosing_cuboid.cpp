@@ -162,7 +162,7 @@ EnclosingCuboid FaceFitCuboid(const FusedCloud& cloud, const BoxFit& fit, int vi
     if (!fit.top_observed) {
         // No top face to fit: the height is where the side faces end.
         c.height_m = envelope::TopBound(in.surface.points, in.sigma, in.height_sigma,
-                                        in.surface.radius, config, &top_se);
+                                        in.surface.radius, config, &top_se, in.surface.view);
     }
     // Each side's excess against the box size across it: the sides against the footprint's
     // other dimension... the face's own span is what a bulge is measured against.

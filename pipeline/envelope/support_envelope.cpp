@@ -16,6 +16,7 @@
 #include "pipeline/envelope/peak_reach.h"
 #include "pipeline/envelope/sloped_layers.h"
 #include "pipeline/envelope/surface_cells.h"
+#include "pipeline/envelope/view_share.h"
 
 namespace boxd::envelope {
 
@@ -204,7 +205,8 @@ Result<EnclosingCuboid> CuboidOf(const Surface& surface, const LeastRectangle& r
         sv.WidthSe() * 1e3, alike.orientations, alike.turn * 180.0 / M_PI, lu * 1e3, lv * 1e3);
     c.length_axis = lu >= lv ? axis : Eigen::Vector2d(-axis.y(), axis.x());
     double se_top = 0.0;
-    c.height_m = TopBound(surface.points, sigma, height_sigma, surface.radius, config, &se_top);
+    c.height_m = TopBound(surface.points, sigma, height_sigma, surface.radius, config, &se_top,
+                          surface.view);
     ReadSharpTop(surface, height_sigma, config, &c.height_m, &se_top);
     const double s_u = averaged ? std::max(su.WidthSe(), alike.se_u) : su.WidthSe();
     const double s_v = averaged ? std::max(sv.WidthSe(), alike.se_v) : sv.WidthSe();
@@ -215,9 +217,14 @@ Result<EnclosingCuboid> CuboidOf(const Surface& surface, const LeastRectangle& r
 }  // namespace
 
 double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double height_sigma,
-                double radius, const EnvelopeConfig& config, double* se) {
+                double radius, const EnvelopeConfig& config, double* se,
+                const std::vector<std::uint16_t>& views) {
     const double cell = 2.0 * config.cell_along_m;
     CellGrid<LayerCell> grid(-radius, radius, -radius, radius, cell, cell);
+    const int view_count = views.size() == pts.size() && !views.empty()
+                               ? 1 + static_cast<int>(*std::max_element(views.begin(), views.end()))
+                               : 0;
+    CellViewSums by_view(view_count > 0 ? grid.cells.size() : 0, view_count);
     std::vector<double> max_z(grid.cells.size(), -INFINITY);
     for (const Eigen::Vector3f& p : pts) {
         if (LayerCell* c = grid.At(p.x(), p.y())) {
@@ -225,17 +232,24 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double he
             max_z[k] = std::max(max_z[k], static_cast<double>(p.z()));
         }
     }
-    for (const Eigen::Vector3f& p : pts) {
-        if (LayerCell* c = grid.At(p.x(), p.y())) {
-            const auto k = static_cast<std::size_t>(c - grid.cells.data());
-            if (p.z() >= max_z[k] - config.layer_sigmas * sigma) c->Add3(p.x(), p.y(), p.z());
-        }
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+        const Eigen::Vector3f& p = pts[i];
+        LayerCell* c = grid.At(p.x(), p.y());
+        if (c == nullptr) continue;
+        const auto k = static_cast<std::size_t>(c - grid.cells.data());
+        if (p.z() < max_z[k] - config.layer_sigmas * sigma) continue;
+        c->Add3(p.x(), p.y(), p.z());
+        if (view_count > 0) by_view.Add(k, views[i], p.x(), p.y(), p.z());
     }
     MarkSlopesToReadHigh(&grid, sigma, config);
     MarkCapTops(&grid, sigma, config);
     MarkRidgesToReadHigh(&grid, config);
+    // Each cell's mean as well as what its views share lets it be known (view_share.h).
+    std::vector<double> shared_se;
+    if (view_count > 0) shared_se = by_view.SharedSe(grid.cells, sigma, config.min_cell_points);
     int judged = 0;
-    return LargestBound(grid.cells, config, sigma, height_sigma, cell, se, &judged, true, true);
+    return LargestBound(grid.cells, config, sigma, height_sigma, cell, se, &judged, true, true,
+                        shared_se.empty() ? nullptr : &shared_se);
 }
 
 FootReach FootAlong(const Surface& surface, const Eigen::Vector2d& u, double sigma,

@@ -5,6 +5,7 @@
 // of objects without flat faces (enclosing_cuboid.h).
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <vector>
 
 #include "pipeline/core/result.h"
@@ -17,9 +18,11 @@ namespace boxd::envelope {
 
 // The height: the top's outer layer over (x, y) cells. `sigma` is the noise of a surface facing
 // up (the table top's about its plane); `height_sigma` the noise of a reading's height where the
-// readings spread up a wall's end (HeightNoiseSigma where no view saw a top).
+// readings spread up a wall's end (HeightNoiseSigma where no view saw a top). `views`, each
+// reading's view where known, tell what a cell's readings share (view_share.h).
 double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double height_sigma,
-                double radius, const EnvelopeConfig& config, double* se);
+                double radius, const EnvelopeConfig& config, double* se,
+                const std::vector<std::uint16_t>& views = {});
 
 // The foot of the surface's outer layer in direction `u` (a unit vector in the table's plane),
 // read from the cells SupportAlong reads it from (foot_band.h).

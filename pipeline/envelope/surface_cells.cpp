@@ -221,7 +221,7 @@ void FloorNoiseAtPooled(const std::vector<LayerCell>& cells, std::vector<Reach>*
 
 double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
                     double noise_sigma, double wall_noise_sigma, double cell_extent_m, double* se,
-                    int* judged, bool walls, bool caps) {
+                    int* judged, bool walls, bool caps, const std::vector<double>* shared_se) {
     const ReachModel model{noise_sigma, config.layer_sigmas * noise_sigma,
                            wall_noise_sigma * wall_noise_sigma, cell_extent_m, walls};
     // Each judged cell's reach, once: it costs an eigen-decomposition of the cell's scatter.
@@ -233,6 +233,12 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
         reaches[k] = CellReach(cells[k], model);
     }
     FloorNoiseAtPooled(cells, &reaches);
+    if (shared_se != nullptr) {
+        for (std::size_t k = 0; k < cells.size(); ++k) {
+            if (reaches[k].facing)
+                reaches[k].noise_se = std::max(reaches[k].noise_se, (*shared_se)[k]);
+        }
+    }
     double top = -INFINITY, top_se = 0.0;
     for (std::size_t k = 0; k < cells.size(); ++k) {
         if (cells[k].n < config.min_cell_points) continue;
