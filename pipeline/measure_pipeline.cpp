@@ -161,6 +161,7 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
     // 7. The smallest enclosing cuboid of the outermost surface, and the shape.
     EnvelopeConfig envelope = config.envelope;
     envelope.narrowest_kept_m = config.fusion.support_voxel_m;
+    envelope.depth_unit_m = session.camera.depth_unit_m;
     const auto cuboid =
         FitEnclosingCuboid(fit.fused, fit.box, n, registered->edges.mean_rmse_m,
                            table.residual_sigma_m, table.camera_to_table.translation(), envelope);
@@ -254,8 +255,9 @@ Result<MeasureOutput> MeasureFromSource(const Session& header, const PoseFrameSo
                                         const MeasureConfig& config, BoxMethod method,
                                         const MonotonicMs& clock) {
     return MeasureAfter(
-        header, [&] { return PrepareFromSource(header, config.Frames(header.calibration), frames); }, config, method,
-        clock);
+        header,
+        [&] { return PrepareFromSource(header, config.Frames(header.calibration), frames); },
+        config, method, clock);
 }
 
 }  // namespace boxd

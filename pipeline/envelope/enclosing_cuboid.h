@@ -80,6 +80,10 @@ struct EnvelopeConfig {
     // The narrowest part the fusion keeps (FusionConfig::support_voxel_m, which the recipe
     // copies here): a sharp apex narrower than this may have no reading left (peak_reach.h).
     double narrowest_kept_m = 0.006;
+    // The recorded depths' unit (CameraIntrinsics::depth_unit_m; set by the recipe): readings at
+    // one depth share what its rounding leaves under their noise, which a leaning face's rows are
+    // known no better than (leaning_face.h).
+    double depth_unit_m = 0.001;
     // Shape: the convex hull of a cuboid's footprint fills its rectangle to at least min_fill
     // (an L missing a quarter fills 7/8, a tube pi/4; rounded edges of a tenth of the side lose
     // a hundredth), and no face stands out of its plane by more than max_relative_excess of the

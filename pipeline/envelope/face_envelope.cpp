@@ -19,6 +19,15 @@ namespace boxd::envelope {
 
 namespace {
 
+// What the rounding of the recorded depths to `unit` leaves in the mean of readings at one
+// depth, under noise `sigma` before the rounding: the sawtooth's standard deviation, the unit
+// over the root of 12, its first harmonic smoothed by exp(-2 pi^2 sigma^2 / unit^2)
+// (depth_rounding.h): nothing beyond half a unit of noise.
+double RoundingLeft(double unit, double sigma) {
+    if (!(unit > 0.0)) return 0.0;
+    return unit / std::sqrt(12.0) * std::exp(-2.0 * M_PI * M_PI * sigma * sigma / (unit * unit));
+}
+
 // The views (each a sample of its mean) a cell needs to be judged. A cell standing out on its
 // own (a strap, a label: ReadExcess, ReadPatches) takes four: three views that agree on an
 // ideal box's cells by a vertical edge, where one of them sees the face at grazing, can put
@@ -38,11 +47,12 @@ constexpr int kMinFlatnessCells = 10;
 // its sensor's disparity steps, so its points are not).
 struct FaceCells {
     int views = 1;
-    int na = 1;                 // cells across the face's grid: a cell's key is row * na + column
-    int nb = 1;                 // cells up the face's grid
-    double da = 1.0, db = 1.0;  // the cells' size across and up the face
-    double b0 = 0.0;            // where the grid's rows start up the face
-    double height = 0.0;        // a side face's height (the top: 0, no lean is read)
+    int na = 1;                  // cells across the face's grid: a cell's key is row * na + column
+    int nb = 1;                  // cells up the face's grid
+    double da = 1.0, db = 1.0;   // the cells' size across and up the face
+    double b0 = 0.0;             // where the grid's rows start up the face
+    double height = 0.0;         // a side face's height (the top: 0, no lean is read)
+    double reading_sigma = 0.0;  // the readings' noise about the faces (BoxFit::face_sigma_m)
     std::unordered_map<std::size_t, CellStats> cell_view;  // key cell * views + view
     std::vector<CellStats> view_plane;                     // per view: offsets near the plane
 
@@ -171,11 +181,12 @@ struct FaceCells {
         ReadExcess(many, config, out.view_spread_m, &out);
         ReadBow(judged, config, &out);
         if (pool.Pooled()) ReadPatches(many, pool.shared, config, &out);
-        ReadLean(judged, &out);
+        ReadLean(judged, RoundingLeft(config.depth_unit_m, reading_sigma), &out);
         return out;
     }
-    // A side face leaning out towards the table or the top (leaning_face.h).
-    void ReadLean(const std::vector<Judged>& judged, FaceResult* out) const {
+    // A side face leaning out towards the table or the top (leaning_face.h); a row known no
+    // better than `row_floor_m`.
+    void ReadLean(const std::vector<Judged>& judged, double row_floor_m, FaceResult* out) const {
         if (!(height > 0.0)) return;
         std::vector<FaceProfileCell> cells;
         cells.reserve(judged.size());
@@ -183,7 +194,7 @@ struct FaceCells {
             const auto row = static_cast<double>(c.key / static_cast<std::size_t>(na));
             cells.push_back({b0 + (row + 0.5) * db, c.st.Mean(), c.se});
         }
-        const auto lean = LeaningFaceReach(cells, db, height);
+        const auto lean = LeaningFaceReach(cells, db, height, row_floor_m);
         if (lean && lean->reach > out->excess_m) {
             out->excess_m = lean->reach;
             out->excess_se_m = lean->se;
@@ -318,6 +329,7 @@ std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& b
         faces[f].db = grids[f].db;
         faces[f].b0 = grids[f].b0;
         faces[f].height = f < 4 ? h : 0.0;
+        faces[f].reading_sigma = box.face_sigma_m;
     }
     // Every reading, as the face fits read them (fusion.h): the support test's voxels keep the
     // readings on one side of a voxel wall and drop the thinner layer on the other, and a face

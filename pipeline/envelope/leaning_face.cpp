@@ -1,5 +1,6 @@
 #include "pipeline/envelope/leaning_face.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -8,9 +9,10 @@ namespace boxd::envelope {
 namespace {
 
 // The face's rows, bottom to top: each row's cells' mean offset, weighed by their standard
-// errors, at the row's mean height; `flip` reads the face from its top down (z from the top).
+// errors, at the row's mean height, known no better than `row_floor_m`; `flip` reads the face
+// from its top down (z from the top).
 std::vector<ProfileRow> FaceRows(const std::vector<FaceProfileCell>& cells, double row_m,
-                                 double height_m, bool flip) {
+                                 double height_m, double row_floor_m, bool flip) {
     struct Sums {
         double w = 0.0, ws = 0.0, wz = 0.0;
     };
@@ -25,16 +27,16 @@ std::vector<ProfileRow> FaceRows(const std::vector<FaceProfileCell>& cells, doub
     }
     std::vector<ProfileRow> rows;
     for (const auto& [row, s] : by_row)
-        rows.push_back({s.ws / s.w, 1.0 / std::sqrt(s.w), s.wz / s.w});
+        rows.push_back({s.ws / s.w, std::max(1.0 / std::sqrt(s.w), row_floor_m), s.wz / s.w});
     return rows;
 }
 
 }  // namespace
 
 std::optional<ProfileFoot> LeaningFaceReach(const std::vector<FaceProfileCell>& cells, double row_m,
-                                            double height_m) {
+                                            double height_m, double row_floor_m) {
     for (const bool flip : {false, true}) {
-        const std::vector<ProfileRow> rows = FaceRows(cells, row_m, height_m, flip);
+        const std::vector<ProfileRow> rows = FaceRows(cells, row_m, height_m, row_floor_m, flip);
         if (const auto line = OutwardLine(rows)) return FootOfLine(rows, *line);
     }
     return std::nullopt;

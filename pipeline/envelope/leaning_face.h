@@ -28,8 +28,11 @@ struct FaceProfileCell {
 
 // Returns how far out of its plane a face `height_m` tall reaches at the end it leans out
 // towards, from `cells` on rows `row_m` apart; none where it stands upright within its noise
-// or fewer than three rows hold cells.
+// or fewer than three rows hold cells. A row is known no better than `row_floor_m`: a row's
+// readings lie at nearly one depth and share what the rounding of the recorded unit leaves
+// under their noise, which no count of them averages away (noise-free boxes' walls leaned by
+// hundredths of a millimetre, and moved out by as much beyond bounds of 0.02-0.05 mm).
 std::optional<ProfileFoot> LeaningFaceReach(const std::vector<FaceProfileCell>& cells, double row_m,
-                                            double height_m);
+                                            double height_m, double row_floor_m = 0.0);
 
 }  // namespace boxd::envelope

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -67,6 +68,18 @@ TEST(LeaningFace, AFaceBendingOutAtItsFootCarriesTheBendInItsBound) {
     ASSERT_TRUE(lean.has_value());
     EXPECT_NEAR(lean->reach, 0.014, 2.0 * lean->se);
     EXPECT_GT(lean->se, 0.001);
+}
+
+TEST(LeaningFace, ARowIsKnownNoBetterThanTheRoundingItsReadingsShare) {
+    // A noise-free wall, its rows off by the recorded unit's rounding at their depths: a lean of
+    // hundredths of a millimetre that the cells' own errors (a micrometre) would call certain.
+    const double h = 0.3;
+    std::vector<FaceProfileCell> cells;
+    for (double z = kMargin + kRow / 2; z < h - kMargin; z += kRow) {
+        for (int c = 0; c < 20; ++c) cells.push_back({z, 0.00005 * (0.5 - z / h), 1e-6});
+    }
+    EXPECT_TRUE(LeaningFaceReach(cells, kRow, h).has_value());
+    EXPECT_FALSE(LeaningFaceReach(cells, kRow, h, 0.001 / std::sqrt(12.0)).has_value());
 }
 
 TEST(LeaningFace, TwoRowsAreNoProfile) {
