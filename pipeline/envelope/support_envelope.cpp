@@ -245,11 +245,9 @@ double TopBound(const std::vector<Eigen::Vector3f>& pts, double sigma, double he
     MarkCapTops(&grid, sigma, config);
     MarkRidgesToReadHigh(&grid, config);
     // Each cell's mean as well as what its views share lets it be known (view_share.h).
-    std::vector<double> shared_se;
-    if (view_count > 0) shared_se = by_view.SharedSe(grid.cells, sigma, config.min_cell_points);
     int judged = 0;
     return LargestBound(grid.cells, config, sigma, height_sigma, cell, se, &judged, true, true,
-                        shared_se.empty() ? nullptr : &shared_se);
+                        view_count > 0 ? &by_view : nullptr);
 }
 
 FootReach FootAlong(const Surface& surface, const Eigen::Vector2d& u, double sigma,

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "pipeline/envelope/cap_reach.h"
+#include "pipeline/envelope/view_share.h"
 
 namespace boxd::envelope {
 
@@ -108,7 +109,7 @@ struct Reach {
     double off_plane = -1.0;  // a facing cell's readings' variance off their plane (-1: none)
 };
 
-// The fewest degrees of freedom a pooled noise is read from (FloorNoiseAtPooled): a few cells.
+// The fewest degrees of freedom a pooled noise floors the cells at (FloorNoise): a few cells.
 constexpr long kMinPooledDof = 30;
 
 // What a cell's reach is read against: the facing surface's noise, the layer's depth, the walls'
@@ -193,6 +194,27 @@ void ReadCapCrest(const std::vector<LayerCell>& cells, const std::vector<Reach>&
     }
 }
 
+// The facing cells' readings' variance off their planes (those on one plane), pooled over its
+// degrees of freedom.
+struct PooledNoise {
+    double variance = 0.0;
+    long dof = 0;
+};
+
+PooledNoise PooledFacingNoise(const std::vector<LayerCell>& cells,
+                              const std::vector<Reach>& reaches) {
+    PooledNoise out;
+    double sum = 0.0;
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+        const Reach& r = reaches[k];
+        if (!r.facing || !(r.off_plane >= 0.0) || cells[k].n <= 3) continue;
+        sum += (cells[k].n - 3) * r.off_plane;
+        out.dof += cells[k].n - 3;
+    }
+    if (out.dof > 0) out.variance = sum / static_cast<double>(out.dof);
+    return out;
+}
+
 // A facing cell's noise is known from its own readings' scatter, a dozen or two of them: its
 // sample variance wanders by a third or more, and among hundreds of cells competing for the
 // largest reach, those whose readings happen to cluster close claim a small noise, are
@@ -200,20 +222,26 @@ void ReadCapCrest(const std::vector<LayerCell>& cells, const std::vector<Reach>&
 // cell's twelve readings scattered 0.48 mm, the sensor's 1.7 mm). The facing cells' scatter off
 // their planes, pooled, is the surface's noise, known from hundreds of cells: no facing cell is
 // known better than that noise over its count of readings.
-void FloorNoiseAtPooled(const std::vector<LayerCell>& cells, std::vector<Reach>* reaches) {
-    double sum = 0.0;
-    long dof = 0;
-    for (std::size_t k = 0; k < cells.size(); ++k) {
-        const Reach& r = (*reaches)[k];
-        if (!r.facing || !(r.off_plane >= 0.0) || cells[k].n <= 3) continue;
-        sum += (cells[k].n - 3) * r.off_plane;
-        dof += cells[k].n - 3;
+// Given `views`, no facing cell is known better than what its views share besides (view_share.h).
+void FloorNoise(const std::vector<LayerCell>& cells, const CellViewSums* views,
+                std::vector<Reach>* reaches) {
+    const PooledNoise pooled = PooledFacingNoise(cells, *reaches);
+    if (pooled.dof >= kMinPooledDof) {
+        for (std::size_t k = 0; k < cells.size(); ++k) {
+            Reach& r = (*reaches)[k];
+            if (r.facing)
+                r.noise_se = std::max(r.noise_se, std::sqrt(pooled.variance / cells[k].n));
+        }
     }
-    if (dof < kMinPooledDof) return;
-    const double pooled = sum / static_cast<double>(dof);
+    if (views == nullptr || pooled.dof == 0) return;
+    std::vector<char> on_plane(cells.size(), 0);
     for (std::size_t k = 0; k < cells.size(); ++k) {
-        Reach& r = (*reaches)[k];
-        if (r.facing) r.noise_se = std::max(r.noise_se, std::sqrt(pooled / cells[k].n));
+        on_plane[k] = (*reaches)[k].facing && (*reaches)[k].off_plane >= 0.0 && cells[k].n > 3;
+    }
+    const std::vector<double> shared = views->SharedSe(cells, on_plane, pooled.variance);
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+        if ((*reaches)[k].facing)
+            (*reaches)[k].noise_se = std::max((*reaches)[k].noise_se, shared[k]);
     }
 }
 
@@ -221,7 +249,7 @@ void FloorNoiseAtPooled(const std::vector<LayerCell>& cells, std::vector<Reach>*
 
 double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
                     double noise_sigma, double wall_noise_sigma, double cell_extent_m, double* se,
-                    int* judged, bool walls, bool caps, const std::vector<double>* shared_se) {
+                    int* judged, bool walls, bool caps, const CellViewSums* views) {
     const ReachModel model{noise_sigma, config.layer_sigmas * noise_sigma,
                            wall_noise_sigma * wall_noise_sigma, cell_extent_m, walls};
     // Each judged cell's reach, once: it costs an eigen-decomposition of the cell's scatter.
@@ -232,13 +260,7 @@ double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& c
         ++m;
         reaches[k] = CellReach(cells[k], model);
     }
-    FloorNoiseAtPooled(cells, &reaches);
-    if (shared_se != nullptr) {
-        for (std::size_t k = 0; k < cells.size(); ++k) {
-            if (reaches[k].facing)
-                reaches[k].noise_se = std::max(reaches[k].noise_se, (*shared_se)[k]);
-        }
-    }
+    FloorNoise(cells, views, &reaches);
     double top = -INFINITY, top_se = 0.0;
     for (std::size_t k = 0; k < cells.size(); ++k) {
         if (cells[k].n < config.min_cell_points) continue;

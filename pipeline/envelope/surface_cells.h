@@ -17,6 +17,8 @@
 
 namespace boxd::envelope {
 
+class CellViewSums;  // view_share.h
+
 // Returns x with P(N(0,1) > x) = q (bisection on the complementary error function).
 double UpperNormalQuantile(double q);
 
@@ -120,12 +122,12 @@ double MedianOfLargest(int m);
 // chosen cell: the fit counts its cells as independent readings of one surface, which errors
 // the fused layer shares over the crest (a registration, the support test's thinning of a
 // layer) are not, and a bag's top read 0.12 mm low against a fit's 0.03 mm.
-// `shared_se`, where given, holds each cell's standard error with what its views share
-// (view_share.h): no facing cell is known better.
+// `views`, where given, hold the cells' readings view by view: no facing cell is then known
+// better than what its views share (view_share.h).
 double LargestBound(const std::vector<LayerCell>& cells, const EnvelopeConfig& config,
                     double noise_sigma, double wall_noise_sigma, double cell_extent_m, double* se,
                     int* judged, bool walls = true, bool caps = false,
-                    const std::vector<double>* shared_se = nullptr);
+                    const CellViewSums* views = nullptr);
 
 // A dense grid of cells over a rectangle of the (a, b) plane.
 template <typename Cell>

@@ -27,22 +27,17 @@ void CellViewSums::Add(std::size_t cell, int view, double a, double b, double s)
     x.s += s;
 }
 
-std::vector<double> CellViewSums::SharedSe(const std::vector<LayerCell>& cells, double sigma,
-                                           int min_points) const {
+std::vector<double> CellViewSums::SharedSe(const std::vector<LayerCell>& cells,
+                                           const std::vector<char>& on_plane,
+                                           double noise_var) const {
     std::vector<double> out(cells.size(), 0.0);
-    std::vector<char> read(cells.size(), 0);
-    // Pooled over the facing cells: the noise off their planes, and the views' scatter about
-    // them less what the noise gives each view's count.
-    double noise_sum = 0.0, spread_sum = 0.0, inverse_sum = 0.0;
-    long noise_dof = 0, spread_dof = 0;
+    // Pooled over the facing cells: the views' scatter about their planes less what the noise
+    // gives each view's count.
+    double spread_sum = 0.0, inverse_sum = 0.0;
+    long spread_dof = 0;
     for (std::size_t k = 0; k < cells.size(); ++k) {
+        if (!on_plane[k]) continue;
         const LayerCell& c = cells[k];
-        if (c.n < min_points) continue;
-        double off_plane = 0.0;
-        if (c.Facing(&off_plane) < 0.5 || !OnOnePlane(off_plane, sigma * sigma, c.n)) continue;
-        read[k] = 1;
-        noise_sum += (c.n - 3) * off_plane;
-        noise_dof += c.n - 3;
         const Eigen::Vector3d centre = c.Centroid(), normal = c.Normal();
         std::vector<double> offsets, inverse;
         for (int v = 0; v < views_; ++v) {
@@ -61,22 +56,21 @@ std::vector<double> CellViewSums::SharedSe(const std::vector<LayerCell>& cells, 
         for (double i : inverse) inverse_sum += i * static_cast<double>(m - 1) / m;
         spread_dof += m - 1;
     }
-    if (spread_dof < kMinSharedDof || noise_dof <= 0) return out;
-    const double noise = noise_sum / static_cast<double>(noise_dof);
+    if (spread_dof < kMinSharedDof) return out;
     const double shared =
-        std::max(0.0, (spread_sum - noise * inverse_sum) / static_cast<double>(spread_dof));
+        std::max(0.0, (spread_sum - noise_var * inverse_sum) / static_cast<double>(spread_dof));
     spdlog::debug(
         "envelope: cells' noise {:.3f} mm, a view's share {:.3f} mm ({} degrees of freedom)",
-        std::sqrt(noise) * 1e3, std::sqrt(shared) * 1e3, spread_dof);
+        std::sqrt(noise_var) * 1e3, std::sqrt(shared) * 1e3, spread_dof);
     for (std::size_t k = 0; k < cells.size(); ++k) {
-        if (!read[k]) continue;
+        if (!on_plane[k]) continue;
         double weights = 0.0;
         for (int v = 0; v < views_; ++v) {
             const double share =
                 static_cast<double>(sums_[k * static_cast<std::size_t>(views_) + v].n) / cells[k].n;
             weights += share * share;
         }
-        out[k] = std::sqrt(shared * weights + noise / cells[k].n);
+        out[k] = std::sqrt(shared * weights + noise_var / cells[k].n);
     }
     return out;
 }

@@ -27,11 +27,11 @@ public:
     void Add(std::size_t cell, int view, double a, double b, double s);
 
     // Per cell, its mean's standard error from what its views share and its readings' noise
-    // (above); 0 where the cell is not judged (fewer than `min_points` readings), does not face
-    // the direction or lies on no one plane, or where too few cells were read by two views or
-    // more to pool. `sigma` is the readings' noise the one-plane test holds them to.
-    std::vector<double> SharedSe(const std::vector<LayerCell>& cells, double sigma,
-                                 int min_points) const;
+    // (above), for the cells `on_plane` marks (judged, facing the direction, on one plane; 0 for
+    // the others), `noise_var` the readings' variance off those cells' planes, pooled; all 0
+    // where too few cells were read by two views or more to pool.
+    std::vector<double> SharedSe(const std::vector<LayerCell>& cells,
+                                 const std::vector<char>& on_plane, double noise_var) const;
 
 private:
     struct Sums {

@@ -40,15 +40,15 @@ Read ReadTop(double shared, unsigned seed) {
         }
     }
     Read out;
-    out.se = sums.SharedSe(cells, kSigma, 12);
+    // Every cell lies on the top's plane; the readings' noise off it is the sensor's.
+    out.se = sums.SharedSe(cells, std::vector<char>(kCells, 1), kSigma * kSigma);
     double sq = 0.0;
     for (const LayerCell& c : cells) sq += (c.Mean() - 0.1) * (c.Mean() - 0.1);
     out.means_spread = std::sqrt(sq / kCells);
     return out;
 }
 
-// Every cell that lies on one plane (all but the one in a few hundred the test's three standard
-// errors turn away) carries `expected` within `share` of it.
+// Every cell judged (not 0) carries `expected` within `share` of it, and nearly all are.
 void ExpectCellsNear(const std::vector<double>& se, double expected, double share) {
     int judged = 0;
     for (double s : se) {
@@ -81,7 +81,7 @@ TEST(CellViewSums, TooFewViewsToPoolTellNothing) {
         cells[0].Add3(0.001 * r, 0.0005 * r, 0.1);
         sums.Add(0, 0, 0.001 * r, 0.0005 * r, 0.1);
     }
-    for (double se : sums.SharedSe(cells, kSigma, 12)) EXPECT_EQ(se, 0.0);
+    for (double se : sums.SharedSe(cells, {1, 0}, kSigma * kSigma)) EXPECT_EQ(se, 0.0);
 }
 
 }  // namespace
