@@ -14,19 +14,11 @@
 #include "pipeline/envelope/leaning_face.h"
 #include "pipeline/envelope/surface_cells.h"
 #include "pipeline/fit/face_choice.h"
+#include "pipeline/views/depth_rounding.h"
 
 namespace boxd::envelope {
 
 namespace {
-
-// What the rounding of the recorded depths to `unit` leaves in the mean of readings at one
-// depth, under noise `sigma` before the rounding: the sawtooth's standard deviation, the unit
-// over the root of 12, its first harmonic smoothed by exp(-2 pi^2 sigma^2 / unit^2)
-// (depth_rounding.h): nothing beyond half a unit of noise.
-double RoundingLeft(double unit, double sigma) {
-    if (!(unit > 0.0)) return 0.0;
-    return unit / std::sqrt(12.0) * std::exp(-2.0 * M_PI * M_PI * sigma * sigma / (unit * unit));
-}
 
 // The views (each a sample of its mean) a cell needs to be judged. A cell standing out on its
 // own (a strap, a label: ReadExcess, ReadPatches) takes four: three views that agree on an
@@ -181,7 +173,7 @@ struct FaceCells {
         ReadExcess(many, config, out.view_spread_m, &out);
         ReadBow(judged, config, &out);
         if (pool.Pooled()) ReadPatches(many, pool.shared, config, &out);
-        ReadLean(judged, RoundingLeft(config.depth_unit_m, reading_sigma), &out);
+        ReadLean(judged, OneDepthRoundingSigma(config.depth_unit_m, reading_sigma), &out);
         return out;
     }
     // A side face leaning out towards the table or the top (leaning_face.h); a row known no

@@ -86,4 +86,10 @@ double SharedRoundingSigma(const RoundingEvidence& evidence, double unit_m) {
     return unit_m / (M_SQRT2 * M_PI) * std::sqrt(sum);
 }
 
+double OneDepthRoundingSigma(double unit_m, double noise_m) {
+    if (!(unit_m > 0.0)) return 0.0;
+    return unit_m / std::sqrt(12.0) *
+           std::exp(-2.0 * M_PI * M_PI * noise_m * noise_m / (unit_m * unit_m));
+}
+
 }  // namespace boxd

@@ -72,4 +72,11 @@ private:
 // its normal (0 where it holds no readings or no unit is known).
 double SharedRoundingSigma(const RoundingEvidence& evidence, double unit_m);
 
+// Returns what the rounding to `unit_m` leaves in the mean of readings at one depth, under
+// noise `noise_m` before the rounding, held no smaller than the series above gives it: the
+// sawtooth's standard deviation, the unit over the root of 12, damped as its first term is,
+// by exp(-2 pi^2 noise^2 / unit^2) (nothing beyond about half a unit of noise; 0 without a
+// unit).
+double OneDepthRoundingSigma(double unit_m, double noise_m);
+
 }  // namespace boxd

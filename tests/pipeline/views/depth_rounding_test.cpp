@@ -82,6 +82,24 @@ TEST(SharedRoundingSigma, LeavesWhatNoiseSpreadsAway) {
     EXPECT_LT(SharedRoundingSigma(noisy, kUnit), 1e-4 * kUnit);
 }
 
+TEST(OneDepthRoundingSigma, HoldsTheSeriesOfReadingsAtOneDepthFromBelow) {
+    // Readings all at one depth, unit gains: the series for them, under no noise and more.
+    for (const double noise : {0.0, kUnit / 6.0, kUnit / 3.0, kUnit / 2.0}) {
+        const RoundingEvidence one = [&] {
+            RoundingEvidence e;
+            e.raw_depths_m.assign(100, 1.00037);
+            e.gains.assign(100, 1.0);
+            e.depth_scatter_m = std::sqrt(kUnit * kUnit / 12.0 + noise * noise);
+            return e;
+        }();
+        const double series = SharedRoundingSigma(one, kUnit);
+        EXPECT_GE(OneDepthRoundingSigma(kUnit, noise), series * (1.0 - 1e-9)) << noise;
+        EXPECT_LE(OneDepthRoundingSigma(kUnit, noise), 1.3 * series + 1e-12) << noise;
+    }
+    EXPECT_NEAR(OneDepthRoundingSigma(kUnit, 0.0), kUnit / std::sqrt(12.0), 1e-12);
+    EXPECT_EQ(OneDepthRoundingSigma(0.0, 0.0), 0.0);
+}
+
 TEST(SharedRoundingSigma, IsNothingWithoutReadingsOrUnit) {
     EXPECT_EQ(SharedRoundingSigma(RoundingEvidence{}, kUnit), 0.0);
     EXPECT_EQ(SharedRoundingSigma(RowsOfOneDepth(10, 10, 1.0, 0.0013, 0.0), 0.0), 0.0);
