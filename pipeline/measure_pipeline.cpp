@@ -106,12 +106,14 @@ FusedFit FuseRegistered(ObjectViews& views, const RegisteredViews& registered,
                         const TablePlaneFit& table, const MeasureConfig& config, StageLaps* laps) {
     const bool single = views.views.size() == 1;
     std::vector<Points> view_points(views.views.size());
+    std::vector<std::vector<float>> raised(views.views.size());
     for (std::size_t k = 0; k < view_points.size(); ++k) {
-        view_points[k] =
-            single ? std::move(views.views[k].points) : std::move(views.views[k].fusion_points);
+        SegmentedView& v = views.views[k];
+        view_points[k] = single ? std::move(v.points) : std::move(v.fusion_points);
+        raised[k] = single ? std::move(v.raised) : std::move(v.fusion_raised);
     }
     FusedFit fit = FuseAndFit(view_points, registered.poses, config.fusion, config.box_fit, laps,
-                              table.camera_to_table.translation().cast<float>());
+                              table.camera_to_table.translation().cast<float>(), &raised);
     if (!single) AddTableReadings(views, registered.poses, &fit.fused);
     return fit;
 }

@@ -24,6 +24,9 @@ struct DepthMap {
     int width = 0;
     int height = 0;
     std::vector<float> z_m;  // row-major, width * height
+    // Where a time-of-flight camera's multipath was taken out (multipath_correction.h): how much
+    // nearer each reading was set, as z-depth (0 for none); empty where nothing was.
+    std::vector<float> multipath_m;
 
     DepthMap() = default;
     DepthMap(int w, int h) : width(w), height(h), z_m(static_cast<std::size_t>(w) * h, 0.0f) {}

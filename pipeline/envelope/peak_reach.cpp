@@ -4,6 +4,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <functional>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -182,23 +183,37 @@ double SteepestFlank(const std::vector<Eigen::Vector3f>& top, const Eigen::Vecto
     return steepest;
 }
 
+// The third highest of the heights of `pts`, each less its `raised` where given (the two highest
+// may be strays), less the median of the largest of as many noise draws as readings compete for
+// it (a ridge's hundreds stand 3 sigma out).
+double HighestReadings(const std::vector<Eigen::Vector3f>& pts, const std::vector<float>& raised,
+                       double noise_sigma) {
+    std::vector<double> z(pts.size());
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+        z[i] = pts[i].z() - (i < raised.size() ? raised[i] : 0.0f);
+    }
+    std::nth_element(z.begin(), z.begin() + 2, z.end(), std::greater<>());
+    const double third = z[2];
+    const auto competing =
+        std::count_if(z.begin(), z.end(), [&](double h) { return h >= third - 2.0 * noise_sigma; });
+    return third - noise_sigma * MedianOfLargest(std::max<int>(1, static_cast<int>(competing)));
+}
+
 }  // namespace
 
 PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
-                          const std::vector<std::uint16_t>& view, double noise_sigma, double band_m,
-                          double narrow_m, double narrowest_m) {
+                          const std::vector<std::uint16_t>& view, const std::vector<float>& raised,
+                          double noise_sigma, double band_m, double narrow_m, double narrowest_m) {
     PeakReach out;
     if (pts.size() < 20) return out;
     std::vector<std::size_t> order(pts.size());
     std::iota(order.begin(), order.end(), 0);
     std::partial_sort(order.begin(), order.begin() + kApexReadings, order.end(),
                       [&](std::size_t a, std::size_t b) { return pts[a].z() > pts[b].z(); });
-    // The third highest reading (the two highest may be strays), less the median of the largest
-    // of as many noise draws as readings compete for it (a ridge's hundreds stand 3 sigma out).
-    const double third = pts[order[2]].z();
-    int competing = 0;
-    for (const Eigen::Vector3f& p : pts) competing += p.z() >= third - 2.0 * noise_sigma ? 1 : 0;
-    out.highest = third - noise_sigma * MedianOfLargest(std::max(1, competing));
+    // The top's shape is read from the readings as corrected; the height they hold, from them
+    // as read.
+    const double reference = HighestReadings(pts, {}, noise_sigma);
+    out.highest = HighestReadings(pts, raised, noise_sigma);
     Eigen::Vector2d apex = Eigen::Vector2d::Zero();
     for (std::size_t i = 0; i < kApexReadings; ++i) {
         apex += pts[order[i]].head<2>().cast<double>() / static_cast<double>(kApexReadings);
@@ -206,7 +221,7 @@ PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
     std::vector<Eigen::Vector3f> top;
     std::vector<std::uint16_t> top_view;
     for (std::size_t i = 0; i < pts.size(); ++i) {
-        if (pts[i].z() < out.highest - band_m) continue;
+        if (pts[i].z() < reference - band_m) continue;
         top.push_back(pts[i]);
         if (i < view.size()) top_view.push_back(view[i]);
     }
@@ -221,8 +236,8 @@ PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
     const bool ridge = eig.eigenvalues()(1) > kRidgeElongation * eig.eigenvalues()(0);
     const Eigen::Vector2d across = eig.eigenvectors().col(0);
-    const auto slope = FlankSlope(top, apex, ridge ? &across : nullptr, out.highest, band_m,
-                                  narrow_m, noise_sigma);
+    const auto slope =
+        FlankSlope(top, apex, ridge ? &across : nullptr, reference, band_m, narrow_m, noise_sigma);
     if (!slope) return out;
     // The apex may stand above the readings by its steepest flank's rise over the farthest it
     // may lie from the nearest: across a ridge, half the readings' spacing; a point among
@@ -239,8 +254,8 @@ PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
 void ReadSharpTop(const Surface& surface, double height_sigma, const EnvelopeConfig& config,
                   double* height, double* se) {
     const PeakReach peak =
-        ExtrapolatePeak(surface.points, surface.view, height_sigma, 2.0 * config.cell_height_m,
-                        config.cell_along_m, config.narrowest_kept_m);
+        ExtrapolatePeak(surface.points, surface.view, surface.raised, height_sigma,
+                        2.0 * config.cell_height_m, config.cell_along_m, config.narrowest_kept_m);
     if (!peak.sharp) {
         // Its highest readings still hold the height from below where they stand above the
         // cells beyond their noise: a top too thin for any cell, its flanks steeper than any

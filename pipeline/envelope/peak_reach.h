@@ -32,14 +32,16 @@ namespace boxd::envelope {
 
 struct PeakReach {
     bool sharp = false;          // a sharp top: the figures below are set
-    double highest = -INFINITY;  // the highest readings (the third highest reading)
+    double highest = -INFINITY;  // the highest readings as read (the third highest reading)
     double above = 0.0;          // how far the apex may stand above them
     double slope = 0.0;          // the steepest flank's rise per metre away from the top
     double spacing = 0.0;        // the views' spacing of readings at the top (m, in 3-D)
 };
 
 // Returns the sharp top of `pts` (table frame, readings above the table; `view`: each reading's
-// view, or empty; `noise_sigma`: a reading's noise in its height), if any: the readings within
+// view, or empty; `raised`: how far a multipath correction raised each, or empty: the highest
+// readings hold the height as read, which multipath only lowers; `noise_sigma`: a reading's
+// noise in its height), if any: the readings within
 // `band_m` below the highest make the top; it is sharp where it widens going down from the
 // highest readings' point (or, where the top runs along a line, from that ridge line) as
 // flanks do, in proportion, from less than `narrow_m` at the top, however gently they rise
@@ -47,8 +49,8 @@ struct PeakReach {
 // strap over a carton, widened below by its edges' mixed pixels, is not sharp).
 // `narrowest_m`: the narrowest part the readings keep (EnvelopeConfig::narrowest_kept_m).
 PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
-                          const std::vector<std::uint16_t>& view, double noise_sigma, double band_m,
-                          double narrow_m, double narrowest_m);
+                          const std::vector<std::uint16_t>& view, const std::vector<float>& raised,
+                          double noise_sigma, double band_m, double narrow_m, double narrowest_m);
 
 // A sharp peak or ridge thins the top's cells out below it (peak_reach.h): its highest
 // readings hold the height where they stand above the cells' `height`, and the apex may stand

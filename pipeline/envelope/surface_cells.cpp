@@ -319,6 +319,7 @@ Surface SurfaceAbove(const FusedCloud& cloud, int max_points, const EnvelopeConf
         if (p.z() < config.min_z_m || (k++ % step) != 0) continue;
         out.points.push_back(p);
         if (i < cloud.view.size()) out.view.push_back(cloud.view[i]);
+        if (i < cloud.raised.size()) out.raised.push_back(cloud.raised[i]);
         out.radius = std::max(out.radius, static_cast<double>(p.head<2>().norm()));
         out.top = std::max(out.top, static_cast<double>(p.z()));
     }

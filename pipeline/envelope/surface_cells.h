@@ -160,6 +160,7 @@ struct CellGrid {
 struct Surface {
     std::vector<Eigen::Vector3f> points;
     std::vector<std::uint16_t> view;  // each point's view (FusedCloud::view), where known
+    std::vector<float> raised;        // how far multipath's correction raised each (FusedCloud)
     double radius = 0.0, top = 0.0;
     std::vector<Eigen::Vector3f> cameras;  // the views' cameras (FusedCloud::cameras), or none
     // The table top's readings beside the object (FusedCloud::table, x and y), and whether they

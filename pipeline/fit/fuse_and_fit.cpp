@@ -6,9 +6,10 @@ namespace boxd {
 
 FusedFit FuseAndFit(const std::vector<Points>& view_points, const std::vector<Se2>& poses,
                     const FusionConfig& fusion, const BoxFitConfig& box_fit, StageLaps* laps,
-                    const std::optional<Eigen::Vector3f>& camera) {
+                    const std::optional<Eigen::Vector3f>& camera,
+                    const std::vector<std::vector<float>>* raised) {
     FusedFit out;
-    out.fused = FuseViews(view_points, poses, fusion, camera);
+    out.fused = FuseViews(view_points, poses, fusion, camera, raised);
     if (laps) laps->Lap("fusion");
     out.box = FitFootprintBox(out.fused.points, out.fused.unfiltered, box_fit,
                               ReadingRays{&out.fused.unfiltered_view, &out.fused.cameras});

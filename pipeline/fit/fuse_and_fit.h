@@ -21,9 +21,11 @@ struct FusedFit {
 
 // Returns the fusion of `view_points` (per view, its own frame) moved by `poses`, and the fits.
 // Laps "fusion" and "fit" on `laps` when given. `camera`: the camera in the views' own frame,
-// when known (the face fits then choose readings by their rays).
+// when known (the face fits then choose readings by their rays); `raised`: per view, how far a
+// multipath correction raised each point (FuseViews).
 FusedFit FuseAndFit(const std::vector<Points>& view_points, const std::vector<Se2>& poses,
                     const FusionConfig& fusion, const BoxFitConfig& box_fit, StageLaps* laps,
-                    const std::optional<Eigen::Vector3f>& camera = std::nullopt);
+                    const std::optional<Eigen::Vector3f>& camera = std::nullopt,
+                    const std::vector<std::vector<float>>* raised = nullptr);
 
 }  // namespace boxd

@@ -24,18 +24,27 @@ Status FusionConfig::Validate() const {
 }
 
 FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& poses,
-                     const FusionConfig& config, const std::optional<Eigen::Vector3f>& camera) {
+                     const FusionConfig& config, const std::optional<Eigen::Vector3f>& camera,
+                     const std::vector<std::vector<float>>* raised) {
     FusedCloud all;
     std::size_t total = 0;
     for (const Points& v : views) total += v.size();
     all.points.reserve(total);
     all.view.reserve(total);
+    // Every view's raise, where every view has one for each of its points.
+    const bool with_raise = raised && raised->size() == views.size() &&
+                            std::equal(views.begin(), views.end(), raised->begin(),
+                                       [](const Points& v, const std::vector<float>& r) {
+                                           return v.size() == r.size();
+                                       });
     for (std::size_t k = 0; k < views.size(); ++k) {
         const Se2Map move(poses[k]);
         for (const Eigen::Vector3f& p : views[k]) {
             all.points.push_back(move(p));
             all.view.push_back(static_cast<std::uint16_t>(k));
         }
+        if (with_raise)
+            all.raised.insert(all.raised.end(), (*raised)[k].begin(), (*raised)[k].end());
     }
     const float inv = static_cast<float>(1.0 / config.support_voxel_m);
     // Each point's voxel (a dense index) and each voxel's point count.
@@ -59,6 +68,7 @@ FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& p
         if (counts[voxel[i]] < required) continue;
         out.points.push_back(all.points[i]);
         out.view.push_back(all.view[i]);
+        if (with_raise) out.raised.push_back(all.raised[i]);
     }
     out.unfiltered = std::move(all.points);
     out.unfiltered_view = std::move(all.view);

@@ -30,6 +30,8 @@ struct FusionConfig {
 struct FusedCloud {
     Points points;                    // table frame of pose 0
     std::vector<std::uint16_t> view;  // source view of each point
+    // How far a multipath correction raised each point (SegmentedView::raised), or empty.
+    std::vector<float> raised;
     // Every point of the views, before the support test. The support test counts points per
     // voxel, so where a face runs near a voxel boundary it keeps the readings on one side of it
     // and drops the thinner layer on the other: a face fitted to the kept points moves by
@@ -55,10 +57,13 @@ struct ConsistencyReport {
 };
 
 // Returns the union of `views` moved by `poses`, without the points of sparsely supported voxels.
-// `camera`: where the camera stands in the views' own frame, when known.
+// `camera`: where the camera stands in the views' own frame, when known. `raised`: per view, how
+// far a multipath correction raised each point, when one was made (a turn about the table's
+// axis keeps it).
 FusedCloud FuseViews(const std::vector<Points>& views, const std::vector<Se2>& poses,
                      const FusionConfig& config,
-                     const std::optional<Eigen::Vector3f>& camera = std::nullopt);
+                     const std::optional<Eigen::Vector3f>& camera = std::nullopt,
+                     const std::vector<std::vector<float>>* raised = nullptr);
 
 // Returns the table readings of the views (`table`, per view, its own frame) moved by `poses`.
 Points FuseTableReadings(const std::vector<Points>& table, const std::vector<Se2>& poses);

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "pipeline/core/median.h"
 
@@ -74,44 +75,93 @@ std::vector<MultipathLight> MultipathGridErrors(const std::vector<MultipathSurfa
     return errors;
 }
 
+namespace {
+
+// The depth `g`'s plane predicts `dx`, `dy` pixels from its centre.
+double PlaneDepth(const MultipathSurface& g, double dx, double dy) {
+    return 1.0 / (1.0 / g.z_m + g.du_inverse_z * dx + g.dv_inverse_z * dy);
+}
+
+// The four samples of the block from (sx, sy) on, in the order (sx, sy), (sx + 1, sy),
+// (sx, sy + 1), (sx + 1, sy + 1) (clamped to the grid).
+std::size_t BlockSample(int gw, int gh, int sx, int sy, int k) {
+    return static_cast<std::size_t>(std::min(sy + k / 2, gh - 1)) * gw +
+           std::min(sx + k % 2, gw - 1);
+}
+
+// Which of the block's samples lie on which one's plane: bit 4 a + b is set where sample a's
+// plane predicts sample b's depth to `on_plane_m`. Where two surfaces meet (a convex edge) a
+// reading may lie on both planes; the samples it lies on are then not one surface.
+std::uint16_t SameSurfaces(const std::vector<MultipathSurface>& grid, int gw, int gh, int stride,
+                           int sx, int sy, double on_plane_m) {
+    std::uint16_t mask = 0;
+    for (int a = 0; a < 4; ++a) {
+        const std::size_t ka = BlockSample(gw, gh, sx, sy, a);
+        for (int b = 0; b < 4; ++b) {
+            const std::size_t kb = BlockSample(gw, gh, sx, sy, b);
+            if (!grid[ka].valid || !grid[kb].valid) continue;
+            const double dx = static_cast<double>(kb % gw) - static_cast<double>(ka % gw);
+            const double dy = static_cast<double>(kb / gw) - static_cast<double>(ka / gw);
+            const double predicted = PlaneDepth(grid[ka], dx * stride, dy * stride);
+            if (std::abs(predicted - grid[kb].z_m) < on_plane_m) mask |= 1u << (4 * a + b);
+        }
+    }
+    return mask;
+}
+
+}  // namespace
+
 std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& grid,
                                         const std::vector<MultipathLight>& errors, int gw,
                                         int stride, const std::vector<float>& z, int width,
-                                        MultipathSpread spread, double on_plane_m) {
+                                        MultipathSpread spread, double on_plane_m,
+                                        std::vector<float>* apart) {
     const int gh = static_cast<int>(grid.size()) / gw;
     const int height = static_cast<int>(z.size()) / width;
+    std::vector<std::uint16_t> same(grid.size());
+    for (int sy = 0; sy < gh; ++sy) {
+        for (int sx = 0; sx < gw; ++sx) {
+            same[static_cast<std::size_t>(sy) * gw + sx] =
+                SameSurfaces(grid, gw, gh, stride, sx, sy, on_plane_m);
+        }
+    }
     std::vector<float> out(z.size(), 0.0f);
+    if (apart) apart->assign(z.size(), 0.0f);
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
-            const float zi = z[static_cast<std::size_t>(y) * width + x];
+            const std::size_t pixel = static_cast<std::size_t>(y) * width + x;
+            const float zi = z[pixel];
             if (!(zi > 0.0f)) continue;
             const double gx = static_cast<double>(x) / stride, gy = static_cast<double>(y) / stride;
-            const int x0 = static_cast<int>(gx), y0 = static_cast<int>(gy);
-            double sum = 0.0, weights = 0.0, smallest = HUGE_VAL;
-            int on_plane = 0;
-            for (int j = 0; j < 2; ++j) {
-                for (int i = 0; i < 2; ++i) {
-                    const int sx = std::min(x0 + i, gw - 1), sy = std::min(y0 + j, gh - 1);
-                    const std::size_t k = static_cast<std::size_t>(sy) * gw + sx;
-                    const MultipathSurface& g = grid[k];
-                    if (!g.valid) continue;
-                    const double predicted =
-                        1.0 / (1.0 / g.z_m + g.du_inverse_z * (x - sx * stride) +
-                               g.dv_inverse_z * (y - sy * stride));
-                    if (!(std::abs(predicted - zi) < on_plane_m)) continue;
-                    const double w =
-                        1e-6 + (i ? gx - x0 : 1.0 - (gx - x0)) * (j ? gy - y0 : 1.0 - (gy - y0));
-                    sum += w * errors[k].error_m;
-                    weights += w;
-                    smallest = std::min(smallest, errors[k].error_m);
-                    ++on_plane;
-                }
+            const int x0 = std::min(static_cast<int>(gx), gw - 1);
+            const int y0 = std::min(static_cast<int>(gy), gh - 1);
+            double sum = 0.0, weights = 0.0, smallest = HUGE_VAL, largest = -HUGE_VAL;
+            unsigned on = 0;  // bit k: the block's sample k lies on the reading's surface
+            for (int k = 0; k < 4; ++k) {
+                const std::size_t s = BlockSample(gw, gh, x0, y0, k);
+                const MultipathSurface& g = grid[s];
+                if (!g.valid) continue;
+                const double predicted = PlaneDepth(g, x - static_cast<double>(s % gw) * stride,
+                                                    y - static_cast<double>(s / gw) * stride);
+                if (!(std::abs(predicted - zi) < on_plane_m)) continue;
+                const double fx = gx - x0, fy = gy - y0;
+                const double w = 1e-6 + (k % 2 ? fx : 1.0 - fx) * (k / 2 ? fy : 1.0 - fy);
+                sum += w * errors[s].error_m;
+                weights += w;
+                smallest = std::min(smallest, errors[s].error_m);
+                largest = std::max(largest, errors[s].error_m);
+                on |= 1u << k;
             }
-            if (weights > 0.0) {
-                const bool inside = spread == MultipathSpread::kBilinear || on_plane == 4;
-                out[static_cast<std::size_t>(y) * width + x] =
-                    static_cast<float>(inside ? sum / weights : smallest);
+            if (!(weights > 0.0)) continue;
+            // One surface: every sample it lies on lies on every other's plane.
+            unsigned pairs = 0;
+            for (int a = 0; a < 4; ++a) {
+                if (on & (1u << a)) pairs |= on << (4 * a);
             }
+            const bool one = (same[static_cast<std::size_t>(y0) * gw + x0] & pairs) == pairs;
+            const bool inside = spread == MultipathSpread::kBilinear || (on == 15u && one);
+            out[pixel] = static_cast<float>(inside ? sum / weights : smallest);
+            if (apart && !one) (*apart)[pixel] = static_cast<float>(largest - smallest);
         }
     }
     return out;
@@ -170,6 +220,8 @@ namespace {
 struct PixelLight {
     std::vector<float> error_m, share;
     std::vector<float> facing_up;  // |the surface normal's component along the table's axis|
+    // Where a reading lies on two surfaces, how far apart their errors are (else 0).
+    std::vector<float> apart_m;
 };
 
 // Returns the light of every reading of the corrected depth `z` (w x h, camera frame of `lens`).
@@ -188,12 +240,12 @@ PixelLight EstimateLight(const std::vector<float>& z, int w, int h, const Camera
     const int step = std::max(1, sampling.source_stride_px / stride);
     std::vector<MultipathLight> light =
         MultipathGridErrors(grid, gw, stride, step, albedo, 0.5 * (lens.fx + lens.fy));
-    auto spread = [&](const std::vector<MultipathLight>& l) {
+    auto spread = [&](const std::vector<MultipathLight>& l, std::vector<float>* apart = nullptr) {
         return MultipathPixelErrors(grid, l, gw, stride, z, w, MultipathSpread::kInsideOrSmallest,
-                                    kOnPlaneM);
+                                    kOnPlaneM, apart);
     };
     PixelLight out;
-    out.error_m = spread(light);
+    out.error_m = spread(light, &out.apart_m);
     for (MultipathLight& l : light) l.error_m = l.indirect_share;
     out.share = spread(light);
     for (std::size_t k = 0; k < grid.size(); ++k) {
@@ -243,12 +295,14 @@ MultipathCorrection CorrectMultipath(DepthMap raw, const CameraIntrinsics& camer
     light = EstimateLight(z, w, h, lens, axis, albedo, scaled);
     const Eigen::Isometry3d to_table = calibration.CameraToTable();
     std::vector<double> above, walls;
+    raw.multipath_m.assign(read.size(), 0.0f);
     for (std::size_t i = 0; i < read.size(); ++i) {
-        if (light.share[i] > kMaxIndirectShare) raw.z_m[i] = 0.0f;
+        if (light.share[i] > kMaxIndirectShare || light.apart_m[i] > kOnPlaneM) raw.z_m[i] = 0.0f;
         const float e = light.error_m[i];
         if (!(raw.z_m[i] > 0.0f) || !(e > 0.0f)) continue;
         out.largest_m = std::max(out.largest_m, static_cast<double>(e));
         raw.z_m[i] -= static_cast<float>(e / calibration.depth_scale);
+        raw.multipath_m[i] = e;
         const int x = static_cast<int>(i % w), y = static_cast<int>(i / w);
         const double zc = read[i] - e;
         const Eigen::Vector3d p((x - lens.cx) / lens.fx * zc, (y - lens.cy) / lens.fy * zc, zc);

@@ -71,11 +71,14 @@ std::vector<MultipathLight> MultipathGridErrors(const std::vector<MultipathSurfa
 enum class MultipathSpread { kBilinear, kInsideOrSmallest };
 
 // Returns the error (z-depth) of every pixel of `z` (width x height, 0 = no reading; 0 where
-// no sample around it lies on its surface).
+// no sample around it lies on its surface). Where the samples whose planes a reading lies on
+// are not one surface (it lies where two meet: each plane does not predict the others'
+// samples), `apart`, if given, gets how far their errors lie apart (0 elsewhere).
 std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& grid,
                                         const std::vector<MultipathLight>& errors, int gw,
                                         int stride, const std::vector<float>& z, int width,
-                                        MultipathSpread spread, double on_plane_m);
+                                        MultipathSpread spread, double on_plane_m,
+                                        std::vector<float>* apart = nullptr);
 
 // The sampling of the sum: the error is smooth on each surface, so it is evaluated every
 // `stride_px` pixels (each sample's surface from a plane through the readings within

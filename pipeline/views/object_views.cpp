@@ -16,7 +16,10 @@ void SegmentObjectView(const DepthMap& depth, const CameraIntrinsics& camera,
                                       camera_to_table.translation().cast<float>());
     // A single view keeps every pixel: with no other view to fuse, its faces' edges are all
     // the footprint there is, and the fusion stride would cut them short by up to 3 pixels.
-    if (!keep_points) view->points = Points{};
+    if (!keep_points) {
+        view->points = Points{};
+        view->raised = {};
+    }
 }
 
 ObjectViews SegmentObjectViews(const std::vector<DepthMap>& depths, const CameraIntrinsics& camera,

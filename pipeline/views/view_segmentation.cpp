@@ -115,6 +115,7 @@ SegmentedView SegmentView(const DepthMap& depth, const CameraIntrinsics& camera,
     const int stride = config.fusion_pixel_stride;
     std::vector<int> picks(static_cast<std::size_t>(depth.width / stride + 1));
     Points table;  // the table top's readings in the measuring volume
+    const bool corrected = depth.multipath_m.size() == depth.z_m.size();
     table.reserve(static_cast<std::size_t>(depth.width) * depth.height);
     for (int v = 0; v < depth.height; ++v) {
         if (v % stride == 0) {
@@ -137,9 +138,16 @@ SegmentedView SegmentView(const DepthMap& depth, const CameraIntrinsics& camera,
                 continue;
             }
             view.points.push_back(p);
+            // As read, before the multipath correction: farther along its ray by that much.
+            const float raised =
+                corrected ? -(rot * Eigen::Vector3f(rx, ry, 1.0f)).z() *
+                                depth.multipath_m[static_cast<std::size_t>(v) * depth.width + u]
+                          : 0.0f;
+            if (corrected) view.raised.push_back(raised);
             if ((u % stride) + stride * (v % stride) ==
                 picks[static_cast<std::size_t>(u / stride)]) {
                 view.fusion_points.push_back(p);
+                if (corrected) view.fusion_raised.push_back(raised);
             }
             if (u < m || v < m || u >= depth.width - m || v >= depth.height - m) {
                 ++view.border_points;

@@ -39,8 +39,12 @@ struct SegmentationConfig {
 };
 
 struct SegmentedView {
-    Points points;           // object points, table frame (every pixel)
-    Points fusion_points;    // one pixel of each fusion_pixel_stride block
+    Points points;         // object points, table frame (every pixel)
+    Points fusion_points;  // one pixel of each fusion_pixel_stride block
+    // How far a time-of-flight camera's multipath correction raised each of `points` and of
+    // `fusion_points` (table frame; DepthMap::multipath_m), or empty where none was made. Multipath
+    // only lengthens paths: a reading as read, this much lower, stands inside the object.
+    std::vector<float> raised, fusion_raised;
     int border_points = 0;   // object points within border_margin_px of the image border
     int outside_points = 0;  // readings above the table just outside the cylinder
     int valid_pixels = 0;    // pixels with a reading in the averaged map

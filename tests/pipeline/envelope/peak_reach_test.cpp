@@ -65,7 +65,7 @@ Cloud Sample(const std::function<double(double, double)>& height, double half, d
 
 // The envelope's figures: a 24 mm band, 12 mm narrow, 6 mm the narrowest part kept.
 PeakReach Peak(const Cloud& c, double noise_sigma = kNoise) {
-    return ExtrapolatePeak(c.points, c.view, noise_sigma, 0.024, 0.012, 0.006);
+    return ExtrapolatePeak(c.points, c.view, {}, noise_sigma, 0.024, 0.012, 0.006);
 }
 
 // A pyramid of base l x w and height h over the origin.
@@ -185,6 +185,33 @@ TEST(PeakReach, AThinTopsHighestReadingsHoldTheHeightAboveItsCells) {
         height = 0.2;
         ReadSharpTop(s, kNoise, EnvelopeConfig{}, &height, &se);
         EXPECT_EQ(height, 0.2) << "seed " << seed;
+    }
+}
+
+// A time-of-flight camera's flat top, 200 mm up, whose edges' corrections set a few readings 4-6
+// mm above it (a convex edge's readings lie on both its surfaces' planes): as corrected they
+// would hold the height above its cells; as read, before their correction raised them, they lie
+// on the top, and multipath only lowers a reading. The top stays where its cells read it.
+TEST(PeakReach, ReadingsACorrectionRaisedHoldTheHeightOnlyAsRead) {
+    auto flat = [](double, double) { return 0.2; };
+    for (unsigned seed = 1; seed <= 3; ++seed) {
+        Cloud top = Sample(flat, 0.1, 1.0, seed);
+        Surface s;
+        s.points = top.points;
+        s.view = top.view;
+        s.raised.assign(top.points.size(), 0.0f);
+        for (int k = 0; k < 6; ++k) {
+            const float up = 0.004f + 0.0004f * static_cast<float>(k);
+            s.points.emplace_back(0.09f * std::cos(k), 0.09f * std::sin(k), 0.2f + up);
+            s.view.push_back(static_cast<std::uint16_t>(k));
+            s.raised.push_back(up);
+        }
+        double height = 0.2, se = 1e-4;
+        ReadSharpTop(s, kNoise, EnvelopeConfig{}, &height, &se);
+        EXPECT_EQ(height, 0.2) << "seed " << seed;
+        s.raised.clear();  // taken as they stand, they would lift it
+        ReadSharpTop(s, kNoise, EnvelopeConfig{}, &height, &se);
+        EXPECT_GT(height, 0.2 + 2.0 * kNoise) << "seed " << seed;
     }
 }
 

@@ -51,12 +51,18 @@ TEST(FuseViews, RemovesPointsOfSparselySupportedVoxels) {
         {},  // a fourth view: the support test applies from four views on
     };
     const std::vector<Se2> poses = {Se2{}, turn, shift, Se2{}};
-    const FusedCloud fused = FuseViews(views, poses, config);
+    // Each reading keeps how far a multipath correction raised it, through the support test.
+    const std::vector<std::vector<float>> raised = {{0.1f, 0.2f, 0.3f, 0.4f}, {0.5f}, {0.6f}, {}};
+    const FusedCloud fused = FuseViews(views, poses, config, std::nullopt, &raised);
     ASSERT_EQ(fused.points.size(), 3u);
+    ASSERT_EQ(fused.raised.size(), 3u);
+    const float kept[3] = {0.4f, 0.5f, 0.6f};  // the views' readings at `common`
     for (std::size_t i = 0; i < 3; ++i) {
         EXPECT_EQ(fused.view[i], i);
         EXPECT_LT((fused.points[i] - common).norm(), 1e-6f);
+        EXPECT_FLOAT_EQ(fused.raised[i], kept[i]);
     }
+    EXPECT_TRUE(FuseViews(views, poses, config).raised.empty());
     // min_support_points = 2 keeps the pair as well, not the lone reading.
     config.min_support_points = 2;
     EXPECT_EQ(FuseViews(views, poses, config).points.size(), 5u);

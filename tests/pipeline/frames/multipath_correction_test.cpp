@@ -68,10 +68,63 @@ TEST(MultipathCorrection, AViewCorrectedFromItsOwnReadingsComesBackToTheTruth) {
     // Nine tenths of the error taken out; the object's typical correction is the walls'.
     EXPECT_LT(Percentile(after_abs, 0.95), 0.1 * Percentile(before_abs, 0.95));
     EXPECT_GT(corrected.largest_m, Percentile(before_abs, 0.95));
-    EXPECT_GT(corrected.share.object_m, 0.002);
+    EXPECT_GT(corrected.share.walls_m, 0.005);
     EXPECT_LT(corrected.share.object_m, corrected.largest_m);
     // The box's walls are corrected more than its top, which nothing lights.
     EXPECT_GT(corrected.share.walls_m, corrected.share.object_m);
+}
+
+// Samples every 8 pixels of two surfaces 1 m away meeting at column 10: the left one square to
+// the camera (its error 0, as a top nothing lights), the right receding 10 mm over the 6 pixels
+// to its samples (its error 10 mm, as a lit wall); two rows of samples, three columns.
+struct Edge {
+    static constexpr int kStride = 8, kColumns = 3, kWidth = 24, kEdge = 10;
+    static constexpr double kRecede = (1.0 - 1.0 / 1.01) / 6.0;  // 1/z per pixel
+    static double Depth(int u) { return u <= kEdge ? 1.0 : 1.0 / (1.0 - kRecede * (u - kEdge)); }
+    std::vector<MultipathSurface> grid;
+    std::vector<MultipathLight> errors;
+    Edge() {
+        for (int row = 0; row < 2; ++row) {
+            for (int col = 0; col < kColumns; ++col) {
+                const bool wall = col * kStride > kEdge;
+                MultipathSurface s;
+                s.valid = true;
+                s.z_m = Depth(col * kStride);
+                s.du_inverse_z = wall ? -kRecede : 0.0;
+                grid.push_back(s);
+                errors.push_back({wall ? 0.010 : 0.0, 0.0});
+            }
+        }
+    }
+    // The error and how far apart the surfaces' errors lie for a reading at column u, row 4.
+    std::pair<float, float> At(int u) const {
+        std::vector<float> z(static_cast<std::size_t>(kWidth) * 16, 0.0f);
+        z[4 * kWidth + u] = static_cast<float>(Depth(u));
+        std::vector<float> apart;
+        const std::vector<float> e =
+            MultipathPixelErrors(grid, errors, kColumns, kStride, z, kWidth,
+                                 MultipathSpread::kInsideOrSmallest, 0.004, &apart);
+        return {e[4 * kWidth + u], apart[4 * kWidth + u]};
+    }
+};
+
+TEST(MultipathCorrection, AReadingWhereTwoSurfacesMeetTakesNeithersErrorBetweenThem) {
+    const Edge edge;
+    // At the edge the reading lies on both planes: the samples round it are all "on its
+    // surface", but they are two surfaces. Their bilinear mean (2.5 mm) would move a top's
+    // reading by a share of its wall's error; it takes the smaller, and says how far apart they
+    // lie.
+    const auto [at_edge, apart] = edge.At(Edge::kEdge);
+    EXPECT_FLOAT_EQ(at_edge, 0.0f);
+    EXPECT_FLOAT_EQ(apart, 0.010f);
+    // Off the edge on the wall, only the wall's samples hold it: the wall's error, no doubt.
+    const auto [on_wall, wall_apart] = edge.At(14);
+    EXPECT_FLOAT_EQ(on_wall, 0.010f);
+    EXPECT_FLOAT_EQ(wall_apart, 0.0f);
+    // Inside the flat surface, all four samples one surface: their bilinear mean.
+    const auto [inside, inside_apart] = edge.At(4);
+    EXPECT_FLOAT_EQ(inside, 0.0f);
+    EXPECT_FLOAT_EQ(inside_apart, 0.0f);
 }
 
 TEST(MultipathCorrection, ALargerImageIsSampledNoMoreDenselyThanAVgaOne) {

@@ -86,6 +86,24 @@ TEST(SegmentView, KeepsBoxAboveMinHeightWithFusionStrideSubset) {
     EXPECT_EQ(view.outside_points, 0);
 }
 
+// A multipath correction set the box's readings 6 mm nearer the camera (the depth's
+// multipath_m): each point keeps how much higher that set it, its ray's rise times the
+// correction; a view without one keeps none.
+TEST(SegmentView, EachPointKeepsHowFarTheMultipathCorrectionRaisedIt) {
+    const CameraIntrinsics cam = SmallCamera();
+    DepthMap depth = Table(cam);
+    Raise(depth, 20, 40, 15, 30, 0.1);
+    EXPECT_TRUE(SegmentView(depth, cam, StationCalibration{}, LookingDown(), SmallVolume(), 0)
+                    .raised.empty());
+    depth.multipath_m.assign(depth.z_m.size(), 0.006f);
+    const SegmentedView view =
+        SegmentView(depth, cam, StationCalibration{}, LookingDown(), SmallVolume(), 0);
+    ASSERT_EQ(view.raised.size(), view.points.size());
+    ASSERT_EQ(view.fusion_raised.size(), view.fusion_points.size());
+    // Straight down, a z-depth of 6 mm is 6 mm of height.
+    for (float r : view.raised) EXPECT_NEAR(r, 0.006, 1e-6);
+}
+
 TEST(SegmentView, EachViewDrawsItsOwnFusionPixels) {
     const CameraIntrinsics cam = SmallCamera();
     DepthMap depth = Table(cam);
