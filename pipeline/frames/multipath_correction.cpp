@@ -119,7 +119,7 @@ std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& gri
     const int gh = static_cast<int>(grid.size()) / gw;
     const int height = static_cast<int>(z.size()) / width;
     std::vector<std::uint16_t> same(grid.size());
-    for (int sy = 0; sy < gh; ++sy) {
+    for (int sy = 0; sy < gh && spread == MultipathSpread::kInsideOrSmallest; ++sy) {
         for (int sx = 0; sx < gw; ++sx) {
             same[static_cast<std::size_t>(sy) * gw + sx] =
                 SameSurfaces(grid, gw, gh, stride, sx, sy, on_plane_m);
@@ -137,12 +137,14 @@ std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& gri
             const int y0 = std::min(static_cast<int>(gy), gh - 1);
             double sum = 0.0, weights = 0.0, smallest = HUGE_VAL, largest = -HUGE_VAL;
             unsigned on = 0;  // bit k: the block's sample k lies on the reading's surface
+            const int column[2] = {x0, std::min(x0 + 1, gw - 1)};
+            const int row[2] = {y0, std::min(y0 + 1, gh - 1)};
             for (int k = 0; k < 4; ++k) {
-                const std::size_t s = BlockSample(gw, gh, x0, y0, k);
+                const int sx = column[k % 2], sy = row[k / 2];
+                const std::size_t s = static_cast<std::size_t>(sy) * gw + sx;
                 const MultipathSurface& g = grid[s];
                 if (!g.valid) continue;
-                const double predicted = PlaneDepth(g, x - static_cast<double>(s % gw) * stride,
-                                                    y - static_cast<double>(s / gw) * stride);
+                const double predicted = PlaneDepth(g, x - sx * stride, y - sy * stride);
                 if (!(std::abs(predicted - zi) < on_plane_m)) continue;
                 const double fx = gx - x0, fy = gy - y0;
                 const double w = 1e-6 + (k % 2 ? fx : 1.0 - fx) * (k / 2 ? fy : 1.0 - fy);
@@ -158,8 +160,10 @@ std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& gri
             for (int a = 0; a < 4; ++a) {
                 if (on & (1u << a)) pairs |= on << (4 * a);
             }
-            const bool one = (same[static_cast<std::size_t>(y0) * gw + x0] & pairs) == pairs;
-            const bool inside = spread == MultipathSpread::kBilinear || (on == 15u && one);
+            const bool bilinear = spread == MultipathSpread::kBilinear;
+            const bool one =
+                bilinear || (same[static_cast<std::size_t>(y0) * gw + x0] & pairs) == pairs;
+            const bool inside = bilinear || (on == 15u && one);
             out[pixel] = static_cast<float>(inside ? sum / weights : smallest);
             if (apart && !one) (*apart)[pixel] = static_cast<float>(largest - smallest);
         }
