@@ -82,28 +82,32 @@ double PlaneDepth(const MultipathSurface& g, double dx, double dy) {
     return 1.0 / (1.0 / g.z_m + g.du_inverse_z * dx + g.dv_inverse_z * dy);
 }
 
-// The four samples of the block from (sx, sy) on, in the order (sx, sy), (sx + 1, sy),
-// (sx, sy + 1), (sx + 1, sy + 1) (clamped to the grid).
-std::size_t BlockSample(int gw, int gh, int sx, int sy, int k) {
-    return static_cast<std::size_t>(std::min(sy + k / 2, gh - 1)) * gw +
-           std::min(sx + k % 2, gw - 1);
-}
+// The four samples of the block from (sx, sy) on, clamped to the grid: sample k at column
+// `column[k % 2]` and row `row[k / 2]`.
+struct Block {
+    int column[2], row[2];
+    Block(int gw, int gh, int sx, int sy)
+        : column{sx, std::min(sx + 1, gw - 1)}, row{sy, std::min(sy + 1, gh - 1)} {}
+    std::size_t Sample(int k, int gw) const {
+        return static_cast<std::size_t>(row[k / 2]) * gw + column[k % 2];
+    }
+};
 
 // Which of the block's samples lie on which one's plane: bit 4 a + b is set where sample a's
 // plane predicts sample b's depth to `on_plane_m`. Where two surfaces meet (a convex edge) a
 // reading may lie on both planes; the samples it lies on are then not one surface.
-std::uint16_t SameSurfaces(const std::vector<MultipathSurface>& grid, int gw, int gh, int stride,
-                           int sx, int sy, double on_plane_m) {
+std::uint16_t SameSurfaces(const std::vector<MultipathSurface>& grid, int gw, const Block& block,
+                           int stride, double on_plane_m) {
     std::uint16_t mask = 0;
     for (int a = 0; a < 4; ++a) {
-        const std::size_t ka = BlockSample(gw, gh, sx, sy, a);
+        const MultipathSurface& ga = grid[block.Sample(a, gw)];
         for (int b = 0; b < 4; ++b) {
-            const std::size_t kb = BlockSample(gw, gh, sx, sy, b);
-            if (!grid[ka].valid || !grid[kb].valid) continue;
-            const double dx = static_cast<double>(kb % gw) - static_cast<double>(ka % gw);
-            const double dy = static_cast<double>(kb / gw) - static_cast<double>(ka / gw);
-            const double predicted = PlaneDepth(grid[ka], dx * stride, dy * stride);
-            if (std::abs(predicted - grid[kb].z_m) < on_plane_m) mask |= 1u << (4 * a + b);
+            const MultipathSurface& gb = grid[block.Sample(b, gw)];
+            if (!ga.valid || !gb.valid) continue;
+            const double predicted =
+                PlaneDepth(ga, (block.column[b % 2] - block.column[a % 2]) * stride,
+                           (block.row[b / 2] - block.row[a / 2]) * stride);
+            if (std::abs(predicted - gb.z_m) < on_plane_m) mask |= 1u << (4 * a + b);
         }
     }
     return mask;
@@ -122,7 +126,7 @@ std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& gri
     for (int sy = 0; sy < gh && spread == MultipathSpread::kInsideOrSmallest; ++sy) {
         for (int sx = 0; sx < gw; ++sx) {
             same[static_cast<std::size_t>(sy) * gw + sx] =
-                SameSurfaces(grid, gw, gh, stride, sx, sy, on_plane_m);
+                SameSurfaces(grid, gw, Block(gw, gh, sx, sy), stride, on_plane_m);
         }
     }
     std::vector<float> out(z.size(), 0.0f);
@@ -137,14 +141,13 @@ std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& gri
             const int y0 = std::min(static_cast<int>(gy), gh - 1);
             double sum = 0.0, weights = 0.0, smallest = HUGE_VAL, largest = -HUGE_VAL;
             unsigned on = 0;  // bit k: the block's sample k lies on the reading's surface
-            const int column[2] = {x0, std::min(x0 + 1, gw - 1)};
-            const int row[2] = {y0, std::min(y0 + 1, gh - 1)};
+            const Block block(gw, gh, x0, y0);
             for (int k = 0; k < 4; ++k) {
-                const int sx = column[k % 2], sy = row[k / 2];
-                const std::size_t s = static_cast<std::size_t>(sy) * gw + sx;
+                const std::size_t s = block.Sample(k, gw);
                 const MultipathSurface& g = grid[s];
                 if (!g.valid) continue;
-                const double predicted = PlaneDepth(g, x - sx * stride, y - sy * stride);
+                const double predicted =
+                    PlaneDepth(g, x - block.column[k % 2] * stride, y - block.row[k / 2] * stride);
                 if (!(std::abs(predicted - zi) < on_plane_m)) continue;
                 const double fx = gx - x0, fy = gy - y0;
                 const double w = 1e-6 + (k % 2 ? fx : 1.0 - fx) * (k / 2 ? fy : 1.0 - fy);
