@@ -194,7 +194,13 @@ void ReadCapCrest(const std::vector<LayerCell>& cells, const std::vector<Reach>&
     }
 }
 
-// The facing cells' readings' variance off their planes (those on one plane), pooled over its
+// Whether a cell's scatter off its plane is pooled as the surface's noise: it faces the
+// direction, its readings lie on one plane, and they are more than a plane's three parameters.
+bool PooledCell(const Reach& r, const LayerCell& c) {
+    return r.facing && r.off_plane >= 0.0 && c.n > 3;
+}
+
+// The facing cells' readings' variance off their planes (PooledCell's), pooled over its
 // degrees of freedom.
 struct PooledNoise {
     double variance = 0.0;
@@ -206,9 +212,8 @@ PooledNoise PooledFacingNoise(const std::vector<LayerCell>& cells,
     PooledNoise out;
     double sum = 0.0;
     for (std::size_t k = 0; k < cells.size(); ++k) {
-        const Reach& r = reaches[k];
-        if (!r.facing || !(r.off_plane >= 0.0) || cells[k].n <= 3) continue;
-        sum += (cells[k].n - 3) * r.off_plane;
+        if (!PooledCell(reaches[k], cells[k])) continue;
+        sum += (cells[k].n - 3) * reaches[k].off_plane;
         out.dof += cells[k].n - 3;
     }
     if (out.dof > 0) out.variance = sum / static_cast<double>(out.dof);
@@ -236,7 +241,7 @@ void FloorNoise(const std::vector<LayerCell>& cells, const CellViewSums* views,
     if (views == nullptr || pooled.dof == 0) return;
     std::vector<char> on_plane(cells.size(), 0);
     for (std::size_t k = 0; k < cells.size(); ++k) {
-        on_plane[k] = (*reaches)[k].facing && (*reaches)[k].off_plane >= 0.0 && cells[k].n > 3;
+        on_plane[k] = PooledCell((*reaches)[k], cells[k]);
     }
     const std::vector<double> shared = views->SharedSe(cells, on_plane, pooled.variance);
     for (std::size_t k = 0; k < cells.size(); ++k) {
