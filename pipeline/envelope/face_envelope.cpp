@@ -39,12 +39,11 @@ constexpr int kMinFlatnessCells = 10;
 // its sensor's disparity steps, so its points are not).
 struct FaceCells {
     int views = 1;
-    int na = 1;                  // cells across the face's grid: a cell's key is row * na + column
-    int nb = 1;                  // cells up the face's grid
-    double da = 1.0, db = 1.0;   // the cells' size across and up the face
-    double b0 = 0.0;             // where the grid's rows start up the face
-    double height = 0.0;         // a side face's height (the top: 0, no lean is read)
-    double reading_sigma = 0.0;  // the readings' noise about the faces (BoxFit::face_sigma_m)
+    int na = 1;                 // cells across the face's grid: a cell's key is row * na + column
+    int nb = 1;                 // cells up the face's grid
+    double da = 1.0, db = 1.0;  // the cells' size across and up the face
+    double b0 = 0.0;            // where the grid's rows start up the face
+    double height = 0.0;        // a side face's height (the top: 0, no lean is read)
     std::unordered_map<std::size_t, CellStats> cell_view;  // key cell * views + view
     std::vector<CellStats> view_plane;                     // per view: offsets near the plane
 
@@ -149,7 +148,10 @@ struct FaceCells {
                                            : std::numeric_limits<double>::quiet_NaN();
     }
 
-    FaceResult Evaluate(const EnvelopeConfig& config, double point_sigma) const {
+    // `point_sigma`: a reading's noise about the face, at least a floor; `reading_sigma`: as the
+    // box fit read it (BoxFit::face_sigma_m).
+    FaceResult Evaluate(const EnvelopeConfig& config, double point_sigma,
+                        double reading_sigma) const {
         const Pool pool = PoolViews(point_sigma);
         const std::vector<Judged> judged = Judge(pool);
         // The plane's offset as each view sees it: their spread is the registration's and the
@@ -321,7 +323,6 @@ std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& b
         faces[f].db = grids[f].db;
         faces[f].b0 = grids[f].b0;
         faces[f].height = f < 4 ? h : 0.0;
-        faces[f].reading_sigma = box.face_sigma_m;
     }
     // Every reading, as the face fits read them (fusion.h): the support test's voxels keep the
     // readings on one side of a voxel wall and drop the thinner layer on the other, and a face
@@ -351,7 +352,7 @@ std::array<FaceResult, 5> FaceEnvelopes(const FusedCloud& cloud, const BoxFit& b
     }
     std::array<FaceResult, 5> out;
     for (std::size_t f = 0; f < 5; ++f) {
-        out[f] = faces[f].Evaluate(config, std::max(box.face_sigma_m, 0.0005));
+        out[f] = faces[f].Evaluate(config, std::max(box.face_sigma_m, 0.0005), box.face_sigma_m);
     }
     return out;
 }
