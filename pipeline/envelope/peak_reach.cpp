@@ -79,29 +79,58 @@ double MedianDrop(const std::vector<Eigen::Vector3f>& top, const Eigen::Vector2d
     return drops.size() < kFlankReadings ? INFINITY : Median(std::move(drops));
 }
 
-// The flanks' slope from how the top widens going down: the readings in kDropBins bins of
-// their drop below `highest`, each bin's median distance from the apex point (or across the
-// ridge line), a line through (drop, distance) by least squares: a flank rising s metres per
-// metre runs 1/s metre out per metre down. A top already `narrow_m` wide where it is highest
-// (a face), one that does not widen (a panel's edge, its width its thickness), widens as a
-// smooth crown does, or is flat where it is highest (its readings there within twice
-// `noise_sigma`, a reading's noise in its height, of the highest), has none.
-std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top,
-                                 const Eigen::Vector2d& apex, const Eigen::Vector2d* across,
-                                 double highest, double band_m, double narrow_m,
-                                 double noise_sigma) {
+// The top's readings in kDropBins bins of their drop below `highest`: each bin's mid drop, its
+// readings' median distance from the apex point (or across the ridge line) and that median's
+// standard error (the interquartile range's sigma, 1.2533 sigma / sqrt(n) for a median).
+struct DropBins {
+    std::vector<double> x, y, se;
+};
+
+DropBins BinByDrop(const std::vector<Eigen::Vector3f>& top, const Eigen::Vector2d& apex,
+                   const Eigen::Vector2d* across, double highest, double band_m,
+                   double noise_sigma) {
     std::vector<std::vector<double>> bins(kDropBins);
     for (const Eigen::Vector3f& p : top) {
         const int bin = static_cast<int>((highest - p.z()) / band_m * kDropBins);
         if (bin < 0 || bin >= kDropBins) continue;
         bins[static_cast<std::size_t>(bin)].push_back(Away(p, apex, across));
     }
-    std::vector<double> x, y;
+    DropBins out;
     for (int b = 0; b < kDropBins; ++b) {
-        if (bins[static_cast<std::size_t>(b)].size() < kBinReadings) continue;
-        x.push_back((b + 0.5) * band_m / kDropBins);
-        y.push_back(Median(bins[static_cast<std::size_t>(b)]));
+        const std::vector<double>& d = bins[static_cast<std::size_t>(b)];
+        // Within twice the noise of the highest, a reading's drop is its noise's more than
+        // the surface's: the readings of a bin there were read from every depth down to
+        // twice as far, and their distances tell no shape.
+        if (d.size() < kBinReadings || (b + 0.5) * band_m / kDropBins < 2.0 * noise_sigma) {
+            continue;
+        }
+        const double sigma = (Quantile(d, 0.75) - Quantile(d, 0.25)) / 1.349;
+        out.x.push_back((b + 0.5) * band_m / kDropBins);
+        out.y.push_back(Median(d));
+        out.se.push_back(1.2533 * sigma / std::sqrt(static_cast<double>(d.size())));
     }
+    return out;
+}
+
+// The 95% quantile of chi-square with `dof` >= 1 degrees of freedom (Wilson and Hilferty's cube:
+// within 1% from three on).
+double ChiSquare95(int dof) {
+    const double k = dof, a = 2.0 / (9.0 * k);
+    return k * std::pow(1.0 - a + 1.644854 * std::sqrt(a), 3);
+}
+
+// The flanks' slope from how the top widens going down: a line through the bins' (drop,
+// distance) by least squares: a flank rising s metres per metre runs 1/s metre out per metre
+// down. A top already `narrow_m` wide where it is highest (a face), one that does not widen (a
+// panel's edge, its width its thickness), widens as a smooth crown does, or is flat where it is
+// highest (its readings there within `noise_sigma`, a reading's noise in its height, of the
+// highest), has none.
+std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top,
+                                 const Eigen::Vector2d& apex, const Eigen::Vector2d* across,
+                                 double highest, double band_m, double narrow_m,
+                                 double noise_sigma) {
+    const DropBins bins = BinByDrop(top, apex, across, highest, band_m, noise_sigma);
+    const std::vector<double>&x = bins.x, &y = bins.y;
     const double n = static_cast<double>(x.size());
     double sx = 0.0, sy = 0.0, sxx = 0.0, sxy = 0.0, sqx = 0.0, sqy = 0.0;
     for (std::size_t i = 0; i < x.size(); ++i) {
@@ -117,14 +146,22 @@ std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top,
     const double run = (n * sxy - sx * sy) / det;  // metres out per metre down
     const double at_top = (sy - run * sx) / n;
     // A smooth crown widens as the root of the drop (a radius of curvature r: d = sqrt(2 r drop)),
-    // a flank in proportion to it: the crown's model fitting better, it is no sharp top.
+    // a flank in proportion to it: the crown's model fitting better, and the line missing the
+    // bins beyond their errors, it is no sharp top. Where the line is within them, the top may be
+    // a point: near a steep apex that no reading reached the noise smears the readings outwards,
+    // and a pyramid's top widens as the root of the drop too (a stereo camera's, its apex 10 mm
+    // above its highest readings, was read as a crown 9.8 mm low within a 2.0 mm bound).
     const double root = sqy / sqx;
-    double line_rss = 0.0, root_rss = 0.0;
+    double line_rss = 0.0, root_rss = 0.0, line_chi2 = 0.0;
     for (std::size_t i = 0; i < x.size(); ++i) {
-        line_rss += std::pow(y[i] - at_top - run * x[i], 2);
+        const double miss = y[i] - at_top - run * x[i];
+        line_rss += miss * miss;
         root_rss += std::pow(y[i] - root * std::sqrt(x[i]), 2);
+        line_chi2 += bins.se[i] > 0.0 ? std::pow(miss / bins.se[i], 2) : INFINITY;
     }
-    if (!(line_rss < root_rss)) return std::nullopt;
+    if (!(line_rss < root_rss) && line_chi2 > ChiSquare95(static_cast<int>(n) - 2)) {
+        return std::nullopt;
+    }
     // A top as wide as a cell where it is highest is a face, not a point or a line.
     if (!(at_top <= narrow_m)) return std::nullopt;
     // However gently the flanks rise, a point is no crown: the top's cells read it at a cell's
@@ -138,10 +175,13 @@ std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top,
     // which the flanks would hold the band's lowest readings, lie mostly on the flanks below it
     // (a pyramid's, smeared along their rays, a median 10 mm below the highest). A top flat where
     // it is highest, whose readings widen only below it (a strap's bar 25 mm wide, the mixed
-    // pixels along its edges), keeps them at its height, within the noise: its top is read, and
-    // no apex stands above it (a handle read 8 mm tall within an 8 mm bound).
-    if (!(MedianDrop(top, apex, across, highest, (at_top + run * band_m) / 2.0) >
-          2.0 * noise_sigma)) {
+    // pixels along its edges), keeps them at its height, within a reading's noise (the bar's
+    // 0.1-0.8 of it): its top is read, and no apex stands above it (a handle read 8 mm tall
+    // within an 8 mm bound). Beyond one noise and within two, the noise cannot tell a flat top
+    // from a point's flanks: read as a point, whose bound reaches down to its highest readings
+    // where a flat top would stand (a stereo camera's steep prism, its ridge's nearest readings
+    // 1.7 noises below its highest, read as flat 3.9 mm low within a 1.3 mm bound).
+    if (!(MedianDrop(top, apex, across, highest, (at_top + run * band_m) / 2.0) > noise_sigma)) {
         return std::nullopt;
     }
     return 1.0 / run;
