@@ -54,15 +54,25 @@ std::optional<RowReach> OutermostInRow(const CellGrid<LayerCell>& layer, int row
 // height. Between them the surface runs nearer level than upright against that line: a ledge,
 // and the rows above it are another wall (a small parcel standing or strapped on a larger one),
 // which a line through both ran out to the table as far as the ledge is deep. A flank's rows,
-// plane or bending, stay within their noise and curvature of it.
+// plane or bending, stay within their noise and curvature of it. Where two rows stand from the
+// departing one up, the step is seen from above too: their line, carried down to the row under
+// them, departs from it as far. A flank's lowest rows read slivers at their cells' feet, their
+// heights a few millimetres apart, and a line through two of them ran 3 times gentler than the
+// wedge it read: its third row stood 11 mm off that line, and the wedge had no foot.
 std::vector<RowReach> OneWall(std::vector<RowReach> rows, double row_height) {
+    auto departs = [row_height](const std::vector<RowReach>& line_rows, const RowReach& row) {
+        const auto line = FitProfile(line_rows, 1);
+        return line && std::abs(row.s - (line->at_table - line->slope * row.z)) > row_height;
+    };
     for (std::size_t k = 2; k < rows.size(); ++k) {
-        const auto below = FitProfile(std::vector<RowReach>(rows.begin(), rows.begin() + k), 1);
-        if (below &&
-            std::abs(rows[k].s - (below->at_table - below->slope * rows[k].z)) > row_height) {
-            rows.resize(k);
-            break;
+        const auto first = rows.begin();
+        const auto at = first + static_cast<std::ptrdiff_t>(k);
+        if (!departs(std::vector<RowReach>(first, at), rows[k])) continue;
+        if (k + 2 <= rows.size() && !departs(std::vector<RowReach>(at, at + 2), rows[k - 1])) {
+            continue;
         }
+        rows.resize(k);
+        break;
     }
     return rows;
 }

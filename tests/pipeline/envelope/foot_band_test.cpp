@@ -115,6 +115,39 @@ TEST(FootBand, ALedgeEndsTheWallItsProfileIsReadFrom) {
     }
 }
 
+// A wedge's flank (running 1.55 m out per metre down, to 226 mm at the table) that nothing read
+// below 20 mm, as its fused readings gave its lowest rows: the first row's readings from 20 to 24
+// mm, the second's a sliver at its foot (24-28 mm, the outer layer of a cell the flank crosses
+// slopingly), and the two off the flank by their noise, 2.4 mm in and 2.3 mm out. The line
+// through those two runs a third as steep, and the third row stands 20 mm off it; the rows above
+// stand on one line that meets the second row, so the wall is one, and its foot is extended
+// (a 480 x 437 mm wedge, read with no foot there, came out 32.5 mm narrow within 1.7 mm).
+TEST(FootBand, AFlanksLowestSliversOffItsLineAreNoLedge) {
+    const EnvelopeConfig config;
+    auto flank = [](double z) { return 0.226 - 1.55 * z; };
+    for (unsigned seed = 1; seed <= 5; ++seed) {
+        std::mt19937 rng(seed);
+        std::normal_distribution<double> noise(0.0, 0.0003);
+        Wall wall{
+            CellGrid<LayerCell>(-0.2, 0.2, 0.0, 0.11, config.cell_along_m, config.cell_height_m),
+            {}};
+        for (double z = 0.020; z <= 0.1; z += 0.0005) {
+            if (z > 0.028 && z < 0.036) continue;  // the second row's outer layer: its foot
+            const double off = z < 0.024 ? -0.0024 : z < 0.036 ? 0.0023 : 0.0;
+            for (double t = -0.15; t <= 0.15; t += 0.002) {
+                const Eigen::Vector3d q(t, z, flank(z) + off + noise(rng));
+                if (LayerCell* c = wall.layer.At(q.x(), q.y())) {
+                    c->Add3(q.x(), q.y(), q.z());
+                    wall.readings.push_back(q);
+                }
+            }
+        }
+        const FootReach foot = ExtrapolateFoot(wall, config);
+        ASSERT_TRUE(std::isfinite(foot.reach)) << "seed " << seed;
+        EXPECT_LT(std::abs(foot.reach - 0.226), 2.0 * foot.se + 0.001) << "seed " << seed;
+    }
+}
+
 // Nothing read below 50 mm (a dark base): the wall is extended from its lowest rows and marked
 // raised, for the table's readings beside it to bound (foot_free_space.h).
 TEST(FootBand, AWallNothingReadBelowIsExtendedAndMarkedRaised) {
