@@ -115,11 +115,16 @@ std::uint16_t SameSurfaces(const std::vector<MultipathSurface>& grid, int gw, co
 
 }  // namespace
 
-std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& grid,
-                                        const std::vector<MultipathLight>& errors, int gw,
-                                        int stride, const std::vector<float>& z, int width,
-                                        MultipathSpread spread, double on_plane_m,
-                                        std::vector<float>* apart) {
+namespace {
+
+// Spreads each of `fields` (a value per grid sample) over the pixels of `z` as
+// MultipathPixelErrors spreads the errors: which samples a reading lies on, their weights and
+// whether they are one surface are found once for all the fields. `apart` reads fields[0].
+std::vector<std::vector<float>> SpreadFields(const std::vector<MultipathSurface>& grid,
+                                             const std::vector<std::vector<double>>& fields, int gw,
+                                             int stride, const std::vector<float>& z, int width,
+                                             MultipathSpread spread, double on_plane_m,
+                                             std::vector<float>* apart) {
     const int gh = static_cast<int>(grid.size()) / gw;
     const int height = static_cast<int>(z.size()) / width;
     std::vector<std::uint16_t> same(grid.size());
@@ -129,7 +134,7 @@ std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& gri
                 SameSurfaces(grid, gw, Block(gw, gh, sx, sy), stride, on_plane_m);
         }
     }
-    std::vector<float> out(z.size(), 0.0f);
+    std::vector<std::vector<float>> out(fields.size(), std::vector<float>(z.size(), 0.0f));
     if (apart) apart->assign(z.size(), 0.0f);
     for (int y = 0; y < height; ++y) {
         for (int x = 0; x < width; ++x) {
@@ -139,7 +144,11 @@ std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& gri
             const double gx = static_cast<double>(x) / stride, gy = static_cast<double>(y) / stride;
             const int x0 = std::min(static_cast<int>(gx), gw - 1);
             const int y0 = std::min(static_cast<int>(gy), gh - 1);
-            double sum = 0.0, weights = 0.0, smallest = HUGE_VAL, largest = -HUGE_VAL;
+            const double fx = gx - x0, fy = gy - y0;
+            // The samples the reading lies on, in the block's order, and their weights.
+            std::size_t samples[4];
+            double weight[4];
+            int count = 0;
             unsigned on = 0;  // bit k: the block's sample k lies on the reading's surface
             const Block block(gw, gh, x0, y0);
             for (int k = 0; k < 4; ++k) {
@@ -149,15 +158,11 @@ std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& gri
                 const double predicted =
                     PlaneDepth(g, x - block.column[k % 2] * stride, y - block.row[k / 2] * stride);
                 if (!(std::abs(predicted - zi) < on_plane_m)) continue;
-                const double fx = gx - x0, fy = gy - y0;
-                const double w = 1e-6 + (k % 2 ? fx : 1.0 - fx) * (k / 2 ? fy : 1.0 - fy);
-                sum += w * errors[s].error_m;
-                weights += w;
-                smallest = std::min(smallest, errors[s].error_m);
-                largest = std::max(largest, errors[s].error_m);
+                samples[count] = s;
+                weight[count++] = 1e-6 + (k % 2 ? fx : 1.0 - fx) * (k / 2 ? fy : 1.0 - fy);
                 on |= 1u << k;
             }
-            if (!(weights > 0.0)) continue;
+            if (count == 0) continue;
             // One surface: every sample it lies on lies on every other's plane.
             unsigned pairs = 0;
             for (int a = 0; a < 4; ++a) {
@@ -167,11 +172,35 @@ std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& gri
             const bool one =
                 bilinear || (same[static_cast<std::size_t>(y0) * gw + x0] & pairs) == pairs;
             const bool inside = bilinear || (on == 15u && one);
-            out[pixel] = static_cast<float>(inside ? sum / weights : smallest);
-            if (apart && !one) (*apart)[pixel] = static_cast<float>(largest - smallest);
+            for (std::size_t f = 0; f < fields.size(); ++f) {
+                double sum = 0.0, weights = 0.0, smallest = HUGE_VAL, largest = -HUGE_VAL;
+                for (int c = 0; c < count; ++c) {
+                    const double v = fields[f][samples[c]];
+                    sum += weight[c] * v;
+                    weights += weight[c];
+                    smallest = std::min(smallest, v);
+                    largest = std::max(largest, v);
+                }
+                out[f][pixel] = static_cast<float>(inside ? sum / weights : smallest);
+                if (f == 0 && apart && !one)
+                    (*apart)[pixel] = static_cast<float>(largest - smallest);
+            }
         }
     }
     return out;
+}
+
+}  // namespace
+
+std::vector<float> MultipathPixelErrors(const std::vector<MultipathSurface>& grid,
+                                        const std::vector<MultipathLight>& errors, int gw,
+                                        int stride, const std::vector<float>& z, int width,
+                                        MultipathSpread spread, double on_plane_m,
+                                        std::vector<float>* apart) {
+    std::vector<double> error(errors.size());
+    for (std::size_t k = 0; k < errors.size(); ++k) error[k] = errors[k].error_m;
+    return std::move(
+        SpreadFields(grid, {error}, gw, stride, z, width, spread, on_plane_m, apart)[0]);
 }
 
 namespace {
@@ -247,18 +276,21 @@ PixelLight EstimateLight(const std::vector<float>& z, int w, int h, const Camera
     const int step = std::max(1, sampling.source_stride_px / stride);
     std::vector<MultipathLight> light =
         MultipathGridErrors(grid, gw, stride, step, albedo, 0.5 * (lens.fx + lens.fy));
-    auto spread = [&](const std::vector<MultipathLight>& l, std::vector<float>* apart = nullptr) {
-        return MultipathPixelErrors(grid, l, gw, stride, z, w, MultipathSpread::kInsideOrSmallest,
-                                    kOnPlaneM, apart);
-    };
-    PixelLight out;
-    out.error_m = spread(light, &out.apart_m);
-    for (MultipathLight& l : light) l.error_m = l.indirect_share;
-    out.share = spread(light);
+    // The error, the share of the light that came another way and how nearly the surface faces
+    // up, each spread from the samples to the readings in one pass.
+    std::vector<std::vector<double>> fields(3, std::vector<double>(grid.size()));
     for (std::size_t k = 0; k < grid.size(); ++k) {
-        light[k].error_m = std::abs(grid[k].normal.dot(table_axis));
+        fields[0][k] = light[k].error_m;
+        fields[1][k] = light[k].indirect_share;
+        fields[2][k] = std::abs(grid[k].normal.dot(table_axis));
     }
-    out.facing_up = spread(light);
+    PixelLight out;
+    std::vector<std::vector<float>> spread =
+        SpreadFields(grid, fields, gw, stride, z, w, MultipathSpread::kInsideOrSmallest, kOnPlaneM,
+                     &out.apart_m);
+    out.error_m = std::move(spread[0]);
+    out.share = std::move(spread[1]);
+    out.facing_up = std::move(spread[2]);
     return out;
 }
 
