@@ -253,7 +253,7 @@ PeakReach ExtrapolatePeak(const std::vector<Eigen::Vector3f>& pts,
     // The top's shape is read from the readings as corrected; the height they hold, from them
     // as read.
     const double reference = HighestReadings(pts, {}, noise_sigma);
-    out.highest = HighestReadings(pts, raised, noise_sigma);
+    out.highest = raised.empty() ? reference : HighestReadings(pts, raised, noise_sigma);
     Eigen::Vector2d apex = Eigen::Vector2d::Zero();
     for (std::size_t i = 0; i < kApexReadings; ++i) {
         apex += pts[order[i]].head<2>().cast<double>() / static_cast<double>(kApexReadings);
