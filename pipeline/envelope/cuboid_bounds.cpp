@@ -45,8 +45,15 @@ std::array<double, 3> CuboidBounds95(const FusedFit& fit, const EnclosingCuboid&
     // which no view's scatter shows; at the table's depth, their difference's.
     const double depth = (table.camera_to_table.inverse() * Eigen::Vector3d::Zero()).z();
     const double pattern = std::sqrt(2.0) * calibration.depth_pattern_m * depth * depth;
-    spdlog::debug("uncertainty: the depth pattern {:.3f} mm in the height", pattern * 1e3);
-    const double shared[3] = {moved[0], moved[1], std::hypot(table.center_se_m, rounding, pattern)};
+    // So are a side facing the camera and the side opposite it, each in the views that face it:
+    // both stand out (or in) by the pattern of those pixels, along the ray's level share.
+    const Eigen::Vector3d camera = table.camera_to_table * Eigen::Vector3d::Zero();
+    const double level = camera.norm() > 0.0 ? camera.head<2>().norm() / camera.norm() : 1.0;
+    const double sides = 2.0 * calibration.depth_pattern_m * depth * depth * level;
+    spdlog::debug("uncertainty: the depth pattern {:.3f} mm in the height, {:.3f} mm in the sides",
+                  pattern * 1e3, sides * 1e3);
+    const double shared[3] = {std::hypot(moved[0], sides), std::hypot(moved[1], sides),
+                              std::hypot(table.center_se_m, rounding, pattern)};
     // A time-of-flight camera's multipath correction, trusted to within its own size
     // (multipath_correction.h): a 95% bound of the walls' in the length and width, of all the
     // object's in the height.

@@ -1,7 +1,7 @@
 #pragma once
 // Envelope stage: the 95% bounds of the enclosing cuboid (SPEC section 5's uncertainty_m) — the
 // faces' own scatter, what the registration may still have moved them by, for the height the
-// table's centre, the depths' rounding and the camera's fixed depth pattern, and a time-of-flight
+// table's centre and the depths' rounding, the camera's fixed depth pattern, and a time-of-flight
 // camera's multipath correction.
 
 #include <array>

@@ -1,8 +1,8 @@
 // The camera's fixed depth pattern through the real binary (calibration/depth_pattern.h): a
 // Kinect station whose depth errs by a smooth per-pixel bias (3 mm knots at 1 m, the same in
 // every frame) is calibrated with a reference box: `boxd calibrate` reads the bias's spread over
-// the image, prints and writes it, and a parcel measured with it carries it in its height's bound,
-// which covers the height's error. A camera without such a bias is calibrated without any.
+// the image, prints and writes it, and a parcel measured with it carries it in its bounds, which
+// cover its errors. A camera without such a bias is calibrated without any.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +10,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tests/support/run_command.h"
@@ -38,7 +39,7 @@ void SynthUncalibrated(const fs::path& out, const std::vector<std::string>& dims
     std::ofstream(file) << session.dump(2);
 }
 
-TEST(CliDepthPattern, CalibrationLearnsThePatternAndTheHeightCarriesIt) {
+TEST(CliDepthPattern, CalibrationLearnsThePatternAndTheBoundsCarryIt) {
     test::TempDir dir;
     double truth = 0.0, unused = 0.0;
     SynthUncalibrated(dir / "reference", {"0.30", "0.20", "0.15"}, "0.003", &truth);
@@ -67,6 +68,15 @@ TEST(CliDepthPattern, CalibrationLearnsThePatternAndTheHeightCarriesIt) {
     const double bound = j.at("uncertainty_m").at("height_m").get<double>();
     EXPECT_GT(bound, 1.96 * std::sqrt(2.0) * learned * 0.8);
     EXPECT_LE(std::abs(j.at("dimensions").at("height_m").get<double>() - 0.25), bound);
+    // So do its length and width: a side facing the camera and the side opposite it are seen at
+    // about the same pixels, each in the views that face it, and both stand out by the pattern
+    // there along the ray's level share (twice the spread times cos 30 degrees at the default
+    // station; at least cos 45 degrees' worth, a little less for the solve's share).
+    for (const auto& [key, truth] : {std::pair{"length_m", 0.40}, std::pair{"width_m", 0.30}}) {
+        const double side = j.at("uncertainty_m").at(key).get<double>();
+        EXPECT_GT(side, 1.96 * 2.0 * M_SQRT1_2 * learned * 0.8) << key;
+        EXPECT_LE(std::abs(j.at("dimensions").at(key).get<double>() - truth), side) << key;
+    }
 }
 
 TEST(CliDepthPattern, ACameraWithoutAPatternIsCalibratedWithoutOne) {
