@@ -72,10 +72,10 @@ TEST(CliDepthPattern, CalibrationLearnsThePatternAndTheBoundsCarryIt) {
     // about the same pixels, each in the views that face it, and both stand out by the pattern
     // there along the ray's level share (twice the spread times cos 30 degrees at the default
     // station; at least cos 45 degrees' worth, a little less for the solve's share).
-    for (const auto& [key, truth] : {std::pair{"length_m", 0.40}, std::pair{"width_m", 0.30}}) {
+    for (const auto& [key, size] : {std::pair{"length_m", 0.40}, std::pair{"width_m", 0.30}}) {
         const double side = j.at("uncertainty_m").at(key).get<double>();
         EXPECT_GT(side, 1.96 * 2.0 * M_SQRT1_2 * learned * 0.8) << key;
-        EXPECT_LE(std::abs(j.at("dimensions").at(key).get<double>() - truth), side) << key;
+        EXPECT_LE(std::abs(j.at("dimensions").at(key).get<double>() - size), side) << key;
     }
 }
 
