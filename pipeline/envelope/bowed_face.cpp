@@ -27,13 +27,6 @@ Eigen::VectorXd Row(double a, double b) {
     return t;
 }
 
-// The upper `q` quantile of chi-square with `k` degrees of freedom (Wilson and Hilferty).
-double UpperChiSquareQuantile(double q, int k) {
-    const double v = 2.0 / (9.0 * k);
-    const double c = 1.0 - v + UpperNormalQuantile(q) * std::sqrt(v);
-    return k * c * c * c;
-}
-
 // The cells as rows of terms, their offsets and weights (1/se²).
 struct System {
     Eigen::MatrixXd rows;

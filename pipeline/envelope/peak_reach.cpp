@@ -112,13 +112,6 @@ DropBins BinByDrop(const std::vector<Eigen::Vector3f>& top, const Eigen::Vector2
     return out;
 }
 
-// The 95% quantile of chi-square with `dof` >= 1 degrees of freedom (Wilson and Hilferty's cube:
-// within 1% from three on).
-double ChiSquare95(int dof) {
-    const double k = dof, a = 2.0 / (9.0 * k);
-    return k * std::pow(1.0 - a + 1.644854 * std::sqrt(a), 3);
-}
-
 // The flanks' slope from how the top widens going down: a line through the bins' (drop,
 // distance) by least squares: a flank rising s metres per metre runs 1/s metre out per metre
 // down. A top already `narrow_m` wide where it is highest (a face), one that does not widen (a
@@ -159,7 +152,8 @@ std::optional<double> FlankSlope(const std::vector<Eigen::Vector3f>& top,
         root_rss += std::pow(y[i] - root * std::sqrt(x[i]), 2);
         line_chi2 += bins.se[i] > 0.0 ? std::pow(miss / bins.se[i], 2) : INFINITY;
     }
-    if (!(line_rss < root_rss) && line_chi2 > ChiSquare95(static_cast<int>(n) - 2)) {
+    if (!(line_rss < root_rss) &&
+        line_chi2 > UpperChiSquareQuantile(0.05, static_cast<int>(n) - 2)) {
         return std::nullopt;
     }
     // A top as wide as a cell where it is highest is a face, not a point or a line.

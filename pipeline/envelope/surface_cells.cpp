@@ -18,6 +18,12 @@ double UpperNormalQuantile(double q) {
     return 0.5 * (lo + hi);
 }
 
+double UpperChiSquareQuantile(double q, int k) {
+    const double v = 2.0 / (9.0 * k);
+    const double c = 1.0 - v + UpperNormalQuantile(q) * std::sqrt(v);
+    return k * c * c * c;
+}
+
 namespace {
 
 // A cap's crest is read from the facing cells within this many cell extents of the chosen one:

@@ -22,6 +22,10 @@ class CellViewSums;  // view_share.h
 // Returns x with P(N(0,1) > x) = q (bisection on the complementary error function).
 double UpperNormalQuantile(double q);
 
+// Returns the upper `q` quantile of chi-square with `k` >= 1 degrees of freedom (Wilson and
+// Hilferty's cube: within 1% from three on).
+double UpperChiSquareQuantile(double q, int k);
+
 struct CellStats {
     int n = 0;
     double sum = 0.0, sum_sq = 0.0;

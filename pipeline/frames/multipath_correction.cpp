@@ -163,6 +163,8 @@ std::vector<std::vector<float>> SpreadFields(const std::vector<MultipathSurface>
                 on |= 1u << k;
             }
             if (count == 0) continue;
+            double weights = 0.0;
+            for (int c = 0; c < count; ++c) weights += weight[c];
             // One surface: every sample it lies on lies on every other's plane.
             unsigned pairs = 0;
             for (int a = 0; a < 4; ++a) {
@@ -173,11 +175,10 @@ std::vector<std::vector<float>> SpreadFields(const std::vector<MultipathSurface>
                 bilinear || (same[static_cast<std::size_t>(y0) * gw + x0] & pairs) == pairs;
             const bool inside = bilinear || (on == 15u && one);
             for (std::size_t f = 0; f < fields.size(); ++f) {
-                double sum = 0.0, weights = 0.0, smallest = HUGE_VAL, largest = -HUGE_VAL;
+                double sum = 0.0, smallest = HUGE_VAL, largest = -HUGE_VAL;
                 for (int c = 0; c < count; ++c) {
                     const double v = fields[f][samples[c]];
                     sum += weight[c] * v;
-                    weights += weight[c];
                     smallest = std::min(smallest, v);
                     largest = std::max(largest, v);
                 }
