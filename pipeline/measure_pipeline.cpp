@@ -172,7 +172,8 @@ MeasureOutput MeasureViews(const Session& session, ViewStream& stream, const Mea
     if (cuboid) {
         FillQuality(*cuboid, &quality);
         const BoundSettings settings{session.camera.depth_unit_m, config.box_fit.min_band_m,
-                                     config.envelope.edge_margin_m};
+                                     config.envelope.edge_margin_m,
+                                     session.calibration.Lens(session.camera).fx};
         uncertainty = CuboidBounds95(fit, *cuboid, *registered, table, session.calibration,
                                      stream.multipath(), settings);
     }

@@ -52,7 +52,16 @@ std::array<double, 3> CuboidBounds95(const FusedFit& fit, const EnclosingCuboid&
     const double sides = 2.0 * calibration.depth_pattern_m * depth * depth * level;
     spdlog::debug("uncertainty: the depth pattern {:.3f} mm in the height, {:.3f} mm in the sides",
                   pattern * 1e3, sides * 1e3);
-    const double shared[3] = {std::hypot(moved[0], sides), std::hypot(moved[1], sides),
+    // The camera's edge growth is learned, and taken off every edge, in whole pixels
+    // (grown_edges.h): each edge keeps up to half a pixel of its growth, or loses up to half a
+    // pixel of itself, and both sides of the object alike. Up to a pixel at the object's depth
+    // in the length and the width, any amount as likely as another.
+    const double grown = calibration.edge_growth_px > 0.0 && settings.focal_px > 0.0
+                             ? depth / settings.focal_px / std::sqrt(3.0)
+                             : 0.0;
+    spdlog::debug("uncertainty: the edge growth's rounding {:.3f} mm in the sides", grown * 1e3);
+    const double shared[3] = {std::hypot(moved[0], sides, grown),
+                              std::hypot(moved[1], sides, grown),
                               std::hypot(table.center_se_m, rounding, pattern)};
     // A time-of-flight camera's multipath correction, trusted to within its own size
     // (multipath_correction.h): a 95% bound of the walls' in the length and width, of all the

@@ -1,8 +1,8 @@
 #pragma once
 // Envelope stage: the 95% bounds of the enclosing cuboid (SPEC section 5's uncertainty_m) — the
 // faces' own scatter, what the registration may still have moved them by, for the height the
-// table's centre and the depths' rounding, the camera's fixed depth pattern, and a time-of-flight
-// camera's multipath correction.
+// table's centre and the depths' rounding, the camera's fixed depth pattern, its edge growth taken
+// off in whole pixels, and a time-of-flight camera's multipath correction.
 
 #include <array>
 
@@ -15,12 +15,14 @@
 
 namespace boxd {
 
-// What the bounds read besides the stages' outputs: the recorded depths' unit, and the face
-// fits' settings the top's rounding is judged with (its band and its edges' margin).
+// What the bounds read besides the stages' outputs: the recorded depths' unit, the face fits'
+// settings the top's rounding is judged with (its band and its edges' margin), and the lens's
+// focal length along the image rows (pixels), which sizes a pixel at the object's depth.
 struct BoundSettings {
     double depth_unit_m = 0.001;
     double min_band_m = 0.0;
     double edge_margin_m = 0.0;
+    double focal_px = 0.0;
 };
 
 // Returns the 95% bound of the length, width and height of `cuboid`, fitted to `fit`'s cloud of

@@ -73,6 +73,11 @@ TEST(CliEdgeGrowth, CalibrationLearnsTheGrowthAndTheMeasurementTakesItAway) {
     EXPECT_GT(FootprintError(without), 0.0015) << without.dump();
     const json with = Measure(dir / "carton", {"--calibration", file.string()});
     EXPECT_LT(FootprintError(with), 0.001) << with.dump();
+    // The growth is known in whole pixels: the length's and width's bounds carry a pixel at the
+    // table's depth (1.7 mm at 1 m), any share of it as likely (cuboid_bounds.h).
+    for (const char* side : {"length_m", "width_m"}) {
+        EXPECT_GT(with.at("uncertainty_m").at(side).get<double>(), 0.0015) << side;
+    }
     EXPECT_EQ(with.at("shape"), "cuboid");
 }
 
