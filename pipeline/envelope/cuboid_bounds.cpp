@@ -54,8 +54,8 @@ std::array<double, 3> CuboidBounds95(const FusedFit& fit, const EnclosingCuboid&
                   pattern * 1e3, sides * 1e3);
     // The camera's edge growth is learned, and taken off every edge, in whole pixels
     // (grown_edges.h): each edge keeps up to half a pixel of its growth, or loses up to half a
-    // pixel of itself, and both sides of the object alike. Up to a pixel at the object's depth
-    // in the length and the width, any amount as likely as another.
+    // pixel of itself, and both sides of the object alike. Up to a pixel at the table's depth,
+    // where the object stands, in the length and the width, any amount as likely as another.
     const double grown = calibration.edge_growth_px > 0.0 && settings.focal_px > 0.0
                              ? depth / settings.focal_px / std::sqrt(3.0)
                              : 0.0;

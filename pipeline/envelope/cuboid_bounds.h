@@ -17,7 +17,7 @@ namespace boxd {
 
 // What the bounds read besides the stages' outputs: the recorded depths' unit, the face fits'
 // settings the top's rounding is judged with (its band and its edges' margin), and the lens's
-// focal length along the image rows (pixels), which sizes a pixel at the object's depth.
+// focal length along the image rows (pixels), which sizes a pixel at the table's depth.
 struct BoundSettings {
     double depth_unit_m = 0.001;
     double min_band_m = 0.0;
